@@ -1,0 +1,125 @@
+// Throughput benchmark: an elastic block under gravity on a fixed base, ~100k particles, a fixed
+// number of steps after a short warm-up, reported as particle-steps per second (DESIGN.md: speed
+// lives in benchmarks, never in timed unit tests).
+#include "bench.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "config.hpp"
+#include "runner.hpp"
+
+namespace loam {
+
+std::string bench_scene(const std::string& scene, const std::string& shape, const std::string& update) {
+  // 2D: 160 x 160 cells of block, 2 x 2 particles per cell = 102 400 particles.
+  // 3D: 24 x 24 x 22 cells of block, 2 x 2 x 2 particles per cell = 101 376 particles.
+  std::string common = "shape_function: " + shape + "\nscheme: {type: single_phase, update: " + update +
+                       "}\ntime: {end: 1.0e3, cfl: 0.5}\n";
+  if (scene == "elastic_block_2d")
+    return common + R"(grid: {origin: [0, 0], extent: [1.0, 1.1], cell_size: 0.00625}
+gravity: [0, -9.81]
+bodies:
+  - name: block
+    generator: {type: box, min: [0, 0], max: [1.0, 1.0]}
+    particles_per_cell: 2
+    material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2000}
+boundaries:
+  - {type: fixed, face: y-}
+  - {type: slip, face: x-}
+  - {type: slip, face: x+}
+)";
+  if (scene == "elastic_block_3d")
+    return common + R"(grid: {origin: [0, 0, 0], extent: [1.0, 1.0, 1.0], cell_size: 0.0416666666666667}
+gravity: [0, 0, -9.81]
+bodies:
+  - name: block
+    generator: {type: box, min: [0, 0, 0], max: [1.0, 1.0, 0.9166666666666667]}
+    particles_per_cell: 2
+    material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2000}
+boundaries:
+  - {type: fixed, face: z-}
+  - {type: slip, face: x-}
+  - {type: slip, face: x+}
+  - {type: slip, face: y-}
+  - {type: slip, face: y+}
+)";
+  return "";
+}
+
+int run_bench(const BenchOptions& opt) {
+  int status = 0;
+  for (const auto& scene : opt.scenes) {
+    std::string yaml = bench_scene(scene, opt.shape, opt.update);
+    if (yaml.empty()) {
+      std::fprintf(stderr, "loam: error: unknown bench scene '%s' (elastic_block_2d, elastic_block_3d)\n",
+                   scene.c_str());
+      return 2;
+    }
+    Diagnostics diag;
+    LoadedConfig cfg = load_config_text(yaml, "<bench " + scene + ">", {}, diag);
+    if (!diag.ok()) {
+      std::fputs(diag.format().c_str(), stderr);
+      return 2;
+    }
+    for (int threads : opt.threads) {
+      std::vector<nlohmann::json> runs;
+      for (int r = 0; r < opt.repeat; ++r) {
+        RunOptions ro;
+        ro.threads = threads;
+        ro.quiet = true;
+        ro.write_output = false;
+        ro.max_steps = 20;  // warm-up: first sorts, page faults, caches
+        ro.profile = opt.profile;
+        RunResult warm = run_config(cfg, ro);
+        ro.max_steps = opt.steps;
+        RunResult res = run_config(cfg, ro);
+        if (res.exit_code) {
+          std::fputs(res.message.c_str(), stderr);
+          status = res.exit_code;
+          continue;
+        }
+        runs.push_back(res.summary);
+      }
+      if (runs.empty()) continue;
+      std::sort(runs.begin(), runs.end(), [](const auto& a, const auto& b) {
+        return a["particle_steps_per_second"].template get<double>() <
+               b["particle_steps_per_second"].template get<double>();
+      });
+      const auto& s = runs[runs.size() / 2];  // median
+      nlohmann::json j;
+      j["scene"] = scene;
+      j["dimension"] = s["dimension"];
+      j["shape_function"] = s["shape_function"];
+      j["scheme"] = s["scheme"];
+      j["update"] = opt.update;
+      j["particles"] = s["particles"];
+      j["steps"] = s["steps"];
+      j["threads"] = threads;
+      j["particle_steps_per_second"] = s["particle_steps_per_second"];
+      j["bytes_per_particle"] = s["bytes_per_particle"];
+      j["repeats"] = opt.repeat;
+      if (s.contains("profile_seconds")) {
+        nlohmann::json prof;
+        double wall = s["wall_seconds"].get<double>();
+        for (const auto& [k, v] : s["profile_seconds"].items()) prof[k] = v.get<double>() / wall;
+        j["profile_fraction"] = prof;
+      }
+      if (opt.json) {
+        std::printf("%s\n", j.dump().c_str());
+      } else {
+        std::printf("%-18s %dD %-8s %-5s %zu particles, %ld steps, %d thread(s): %7.2f M particle-steps/s, %zu B/particle\n",
+                    scene.c_str(), s["dimension"].get<int>(), opt.shape.c_str(), opt.update.c_str(),
+                    s["particles"].get<size_t>(), s["steps"].get<long>(), threads,
+                    s["particle_steps_per_second"].get<double>() / 1e6,
+                    s["bytes_per_particle"].get<size_t>());
+        if (j.contains("profile_fraction")) std::printf("    profile: %s\n", j["profile_fraction"].dump().c_str());
+      }
+      std::fflush(stdout);
+    }
+  }
+  return status;
+}
+
+}  // namespace loam

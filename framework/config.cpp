@@ -1,0 +1,255 @@
+#include "config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "particles.hpp"
+#include "registry.hpp"
+
+namespace loam {
+
+Schema config_schema() {
+  Schema s;
+  s.string_list("plugins", "shared libraries with out-of-tree plugins, loaded before validation");
+  {
+    Schema g;
+    g.vector("origin", "m", "lower corner of the grid").def("0").scalar_ok();
+    g.vector("extent", "m", "size of the grid along each axis; its length sets the dimension (1, 2 or 3)")
+        .required()
+        .positive();
+    g.vector("cell_size", "m", "cell size (one number or one per axis); the extent must be a multiple")
+        .required()
+        .positive()
+        .scalar_ok();
+    s.section("grid", g, "background grid").required();
+  }
+  s.plugin("shape_function", "shape_function", "interpolation between particles and nodes").def("linear");
+  s.plugin("scheme", "scheme", "what one explicit step does (mixture formulation, update order)")
+      .def("single_phase");
+  s.vector("gravity", "m/s^2", "gravitational acceleration").def("0").scalar_ok();
+  {
+    Schema b;
+    b.text("name", "body name, used by loads, particle sets and output").required();
+    b.plugin("generator", "generator", "region filled with particles").required();
+    b.integer("particles_per_cell", "particles per cell along each axis").def("2").min(1).max(10);
+    b.plugin("material", "material", "constitutive model of the body").required();
+    b.plugin("velocity", "field", "initial velocity (a list is a constant)").components(kDimension);
+    b.plugin("stress", "field", "initial Cauchy stress, Voigt xx yy zz xy yz xz (tension positive)")
+        .components(-100);  // resolved to the stress component count below
+    s.section_list("bodies", b, "bodies of particles").required();
+  }
+  {
+    Schema ps;
+    ps.text("name", "set name, referred to by loads").required();
+    ps.vector("min", "m", "lower corner of the selection box").required();
+    ps.vector("max", "m", "upper corner of the selection box").required();
+    s.section_list("particle_sets", ps, "named sets of particles (box selections at t = 0)");
+  }
+  s.plugin_list("boundaries", "boundary", "boundary conditions on grid faces");
+  s.plugin_list("loads", "load", "external loads");
+  s.plugin("damping", "damping", "numerical damping (e.g. to reach a static state)");
+  {
+    Schema t;
+    t.real("end", "s", "simulated end time").required().positive();
+    t.real("cfl", "-", "Courant number: dt = cfl * cell / (wave speed + particle speed)")
+        .def("0.5")
+        .above(0)
+        .max(1);
+    t.real("dt", "s", "fixed time step (overrides cfl)").positive();
+    s.section("time", t, "time integration").required();
+  }
+  {
+    Schema o;
+    o.integer("every_steps", "write a frame every N steps").min(1);
+    o.real("every_time", "s", "write a frame every T seconds of simulated time").positive();
+    o.string_list("fields", "particle fields to write besides position (see `loam fields`)")
+        .def("[velocity, stress]");
+    o.plugin("writer", "writer", "output format").def("xdmf");
+    o.integer("history_every", "write energies and momentum to history.csv every N steps (0: at frames)")
+        .def("0")
+        .min(0);
+    s.section("output", o, "output of particle frames");
+  }
+  {
+    Schema p;
+    p.text("name", "probe name; written to probe_<name>.csv").required();
+    p.vector("particle_near", "m", "follow the particle nearest to this point at t = 0");
+    p.vector("node", "-", "grid node indices (i, j, k)");
+    p.string_list("fields", "fields to record").def("[position, velocity]");
+    p.integer("every_steps", "sample every N steps").def("1").min(1);
+    s.section_list("probes", p, "time series at a particle or a node, written as CSV");
+  }
+  s.plugin("verify", "reference", "analytic reference; its error metrics go to summary.json");
+  {
+    Schema n;
+    n.integer("sort_every", "sort particles by cell every N steps (locality, thread partition)")
+        .def("20")
+        .min(1);
+    n.real("mass_tolerance", "kg", "nodes with less mass get zero velocity (guards division)")
+        .def("1e-12")
+        .positive();
+    n.integer("check_every", "check particles for NaN/inf and leaving the grid every N steps")
+        .def("10")
+        .min(1);
+    s.section("numerics", n, "numerical controls");
+  }
+  return s;
+}
+
+namespace {
+
+/// Apply `a.b.c=value` to the YAML tree; list elements are addressed by index (bodies.0.name).
+bool apply_override(YAML::Node root, const std::string& arg, const std::string& label,
+                    Diagnostics& diag, std::string& path_out) {
+  auto eq = arg.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    diag.error(Location{label, 1, 1}, arg, "expected --set path.to.key=value");
+    return false;
+  }
+  std::string path = arg.substr(0, eq), text = arg.substr(eq + 1);
+  path_out = path;
+  YAML::Node value;
+  try {
+    value = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    diag.error(Location{label, 1, int(eq) + 2 + std::max(0, e.mark.column)}, path,
+               "malformed YAML value: " + e.msg);
+    return false;
+  }
+  std::vector<std::string> parts;
+  std::stringstream ss(path);
+  for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
+  // Walk with an explicit chain of nodes: yaml-cpp's operator[] on a map creates entries.
+  std::vector<YAML::Node> chain{root};
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    YAML::Node cur = chain.back();
+    const std::string& k = parts[i];
+    bool is_index = !k.empty() && k.find_first_not_of("0123456789") == std::string::npos;
+    if (cur.IsSequence()) {
+      if (!is_index || std::stoul(k) >= cur.size()) {
+        diag.error(Location{label, 1, 1}, path,
+                   "'" + k + "' is not an index of the list (it has " +
+                       std::to_string(cur.size()) + " entries)");
+        return false;
+      }
+      chain.push_back(cur[std::stoul(k)]);
+    } else {
+      if (!cur[k] || cur[k].IsNull()) cur[k] = YAML::Node(YAML::NodeType::Map);
+      chain.push_back(cur[k]);
+    }
+  }
+  YAML::Node parent = chain.back();
+  const std::string& last = parts.back();
+  if (parent.IsSequence()) {
+    bool is_index = last.find_first_not_of("0123456789") == std::string::npos;
+    if (!is_index || std::stoul(last) >= parent.size()) {
+      diag.error(Location{label, 1, 1}, path, "'" + last + "' is not an index of the list");
+      return false;
+    }
+    parent[std::stoul(last)] = value;
+  } else {
+    parent[last] = value;
+  }
+  return true;
+}
+
+int detect_dimension(const YAML::Node& root) {
+  YAML::Node e = root.IsMap() && root["grid"] && root["grid"].IsMap() ? root["grid"]["extent"]
+                                                                         : YAML::Node();
+  if (e && e.IsSequence() && e.size() >= 1 && e.size() <= 3) return int(e.size());
+  return 0;
+}
+
+LoadedConfig validate_tree(YAML::Node root, const std::string& file,
+                           const std::vector<std::string>& overrides, Diagnostics& diag) {
+  LoadedConfig out;
+  out.file = file;
+  out.name = std::filesystem::path(file).stem().string();
+  ValidationContext ctx;
+  ctx.file = file;
+  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+  if (!root.IsMap()) {
+    diag.error(Location{file, root.Mark().line + 1, root.Mark().column + 1}, "",
+               "a run file must be a map of keys (grid, bodies, time, ...)");
+    return out;
+  }
+  for (size_t i = 0; i < overrides.size(); ++i) {
+    std::string label = "<--set " + overrides[i] + ">", path;
+    if (apply_override(root, overrides[i], label, diag, path)) ctx.overrides[path] = label;
+  }
+  // Out-of-tree plugins register before anything names them.
+  if (root["plugins"] && root["plugins"].IsSequence())
+    for (size_t i = 0; i < root["plugins"].size(); ++i) {
+      YAML::Node p = root["plugins"][i];
+      std::string where = "plugins." + std::to_string(i);
+      if (!p.IsScalar()) continue;  // reported by validation
+      std::filesystem::path lib(p.Scalar());
+      if (lib.is_relative()) lib = std::filesystem::path(file).parent_path() / lib;
+      Location loc = location_of(p, where, ctx, Location{file, 1, 1});
+      if (!std::filesystem::exists(lib)) {
+        diag.error(loc, where, "plugin library not found: " + lib.string());
+        continue;
+      }
+      std::string err = load_plugin_library(lib.string());
+      if (!err.empty()) diag.error(loc, where, err);
+    }
+  out.dimension = detect_dimension(root);
+  ctx.dimension = out.dimension ? out.dimension : 2;
+  if (!out.dimension && root["grid"] && root["grid"].IsMap() && root["grid"]["extent"] &&
+      root["grid"]["extent"].IsSequence()) {
+    YAML::Node e = root["grid"]["extent"];
+    diag.error(location_of(e, "grid.extent", ctx, Location{file, 1, 1}), "grid.extent",
+               "the grid needs 1, 2 or 3 components (one per dimension), got " +
+                   std::to_string(e.size()));
+  }
+  Schema schema = config_schema();
+  // Stress fields have 3 + D(D-1)/2 components (Voigt, with the out-of-plane normal stress).
+  for (auto& p : schema.params)
+    if (p.key == "bodies")
+      for (auto& q : p.section->params)
+        if (q.key == "stress") q.plugin_components = stress_components(ctx.dimension);
+  out.params = validate(root, schema, "", Location{file, 1, 1}, ctx, diag);
+  return out;
+}
+
+Location parse_error_location(const YAML::Exception& e, const std::string& file) {
+  return Location{file, std::max(0, e.mark.line) + 1, std::max(0, e.mark.column) + 1};
+}
+
+}  // namespace
+
+LoadedConfig load_config_text(const std::string& text, const std::string& label,
+                              const std::vector<std::string>& overrides, Diagnostics& diag) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    diag.error(parse_error_location(e, label), "", "malformed YAML: " + e.msg);
+    LoadedConfig out;
+    out.file = label;
+    return out;
+  }
+  return validate_tree(root, label, overrides, diag);
+}
+
+LoadedConfig load_config(const std::string& file, const std::vector<std::string>& overrides,
+                         Diagnostics& diag) {
+  std::ifstream in(file);
+  if (!in) {
+    diag.error(Location{file, 1, 1}, "", "cannot open the run file: " +
+                                             std::string(std::filesystem::exists(file)
+                                                             ? "permission denied"
+                                                             : "no such file"));
+    LoadedConfig out;
+    out.file = file;
+    return out;
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return load_config_text(ss.str(), file, overrides, diag);
+}
+
+}  // namespace loam

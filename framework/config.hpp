@@ -1,0 +1,29 @@
+#pragma once
+// Loading a run configuration: YAML file, --set overrides, out-of-tree plugin libraries, and
+// validation of the whole tree against the schema (every error at once, before any work).
+#include <string>
+#include <vector>
+
+#include "diagnostics.hpp"
+#include "params.hpp"
+
+namespace loam {
+
+/// The schema of a run file (top level). Documented by `loam plugins --config`.
+Schema config_schema();
+
+struct LoadedConfig {
+  Params params;
+  int dimension = 0;
+  std::string file;
+  std::string name;  // file stem, for the default output directory
+};
+
+/// Read, override, validate. On any error, diag holds every message and the result is unusable.
+LoadedConfig load_config(const std::string& file, const std::vector<std::string>& overrides,
+                         Diagnostics& diag);
+/// Same, from YAML text (used by tests and `loam bench`).
+LoadedConfig load_config_text(const std::string& text, const std::string& label,
+                              const std::vector<std::string>& overrides, Diagnostics& diag);
+
+}  // namespace loam

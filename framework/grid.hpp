@@ -1,0 +1,77 @@
+#pragma once
+// Uniform Cartesian background grid, templated on dimension. Node (i, j, k) has linear index
+// i + nx*(j + ny*k); the last axis varies slowest, so slabs of cell rows along it are contiguous
+// in memory and in the cell-sorted particle order.
+#include <array>
+#include <cmath>
+#include <cstddef>
+
+namespace loam {
+
+template <int D>
+struct Grid {
+  std::array<double, D> origin{}, cell{}, inv_cell{};
+  std::array<int, D> cells{}, nodes{};
+  std::array<long, D> node_stride{}, cell_stride{};
+  size_t num_nodes = 0, num_cells = 0;
+
+  void init(const std::array<double, D>& o, const std::array<double, D>& extent,
+            const std::array<double, D>& h) {
+    origin = o;
+    num_nodes = num_cells = 1;
+    for (int d = 0; d < D; ++d) {
+      cells[d] = int(std::lround(extent[d] / h[d]));
+      cell[d] = extent[d] / cells[d];  // exact fit of the extent
+      inv_cell[d] = 1.0 / cell[d];
+      nodes[d] = cells[d] + 1;
+      node_stride[d] = long(num_nodes);
+      cell_stride[d] = long(num_cells);
+      num_nodes *= size_t(nodes[d]);
+      num_cells *= size_t(cells[d]);
+    }
+  }
+
+  double min_cell() const {
+    double h = cell[0];
+    for (int d = 1; d < D; ++d) h = std::fmin(h, cell[d]);
+    return h;
+  }
+  double upper(int d) const { return origin[d] + cells[d] * cell[d]; }
+
+  std::array<int, D> node_ijk(size_t n) const {
+    std::array<int, D> ijk{};
+    for (int d = 0; d < D; ++d) {
+      ijk[d] = int(n % size_t(nodes[d]));
+      n /= size_t(nodes[d]);
+    }
+    return ijk;
+  }
+  double node_coord(size_t n, int d) const { return origin[d] + node_ijk(n)[d] * cell[d]; }
+
+  /// Cell index along axis d of a coordinate, clamped into the grid.
+  int cell_of(double x, int d) const {
+    int c = int(std::floor((x - origin[d]) * inv_cell[d]));
+    return c < 0 ? 0 : (c >= cells[d] ? cells[d] - 1 : c);
+  }
+  size_t cell_index(const std::array<double, D>& x) const {
+    size_t c = 0;
+    for (int d = 0; d < D; ++d) c += size_t(cell_of(x[d], d)) * size_t(cell_stride[d]);
+    return c;
+  }
+  bool inside(const std::array<double, D>& x) const {
+    for (int d = 0; d < D; ++d)
+      if (!(x[d] >= origin[d] && x[d] <= upper(d))) return false;
+    return true;
+  }
+};
+
+/// A D-vector stored per node inside an interleaved node record:
+/// component d of node n is base[n*stride + offset + d].
+struct NodalVector {
+  double* base;
+  int stride;
+  int offset;
+  double& at(size_t n, int d) const { return base[n * size_t(stride) + size_t(offset + d)]; }
+};
+
+}  // namespace loam

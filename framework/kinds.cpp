@@ -1,0 +1,13 @@
+// The plugin kinds the core knows (never the plugins themselves), in `loam plugins` order.
+#include "registry.hpp"
+
+LOAM_REGISTER_KIND("shape_function", "interpolation between particles and grid nodes")
+LOAM_REGISTER_KIND("scheme", "what one explicit step does (mixture formulation, update order)")
+LOAM_REGISTER_KIND("material", "constitutive model; stress tension positive (Pa)")
+LOAM_REGISTER_KIND("boundary", "constraints on grid-face nodes")
+LOAM_REGISTER_KIND("load", "external forces on particles or nodes")
+LOAM_REGISTER_KIND("damping", "numerical damping of nodal forces")
+LOAM_REGISTER_KIND("generator", "regions filled with particles")
+LOAM_REGISTER_KIND("field", "spatial fields for initial conditions (a list is a constant)")
+LOAM_REGISTER_KIND("reference", "analytic references for `verify:`, with error metrics")
+LOAM_REGISTER_KIND("writer", "output formats")

@@ -1,0 +1,31 @@
+#pragma once
+// Load plugin interface. A load adds to the particles' external force before the scatter, or to
+// nodal forces after it, at time t.
+#include "grid.hpp"
+
+namespace loam {
+
+template <int D>
+class Simulation;
+class Diagnostics;
+
+template <int D>
+class Load {
+ public:
+  static constexpr const char* kind = "load";
+  virtual ~Load() = default;
+  virtual void setup(Simulation<D>&, Diagnostics&) {}
+  /// Add to the `external_force` particle field (zeroed by the framework every step).
+  virtual void apply_to_particles(Simulation<D>&, double /*t*/) {}
+  /// Add to nodal forces after the scatter.
+  virtual void apply_to_grid(Simulation<D>&, const NodalVector& /*force*/, double /*t*/) {}
+  /// Whether this load writes particle external forces (the field is allocated only then).
+  virtual bool uses_particle_forces() const { return false; }
+};
+
+/// Linear ramp from 0 at t=0 to 1 at t=ramp_time (1 throughout if ramp_time is 0).
+inline double ramp_factor(double t, double ramp_time) {
+  return ramp_time > 0 && t < ramp_time ? t / ramp_time : 1.0;
+}
+
+}  // namespace loam

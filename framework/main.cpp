@@ -1,0 +1,95 @@
+// The `loam` command line: run, check, plugins, schema, bench.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "bench.hpp"
+#include "config.hpp"
+#include "docs.hpp"
+#include "runner.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"loam: explicit Material Point Method for geomechanics"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", loam::loam_version() + " (" + loam::git_commit() + ")");
+
+  loam::RunOptions run_opt;
+  std::string run_file;
+  auto* run = app.add_subcommand("run", "validate and run a scene");
+  run->add_option("config", run_file, "run file (YAML)")->required();
+  run->add_option("--set", run_opt.overrides, "override a key: path.to.key=value (repeatable)")
+      ->allow_extra_args(false);
+  run->add_option("--out", run_opt.out_dir, "output directory (default results/<config name>)");
+  run->add_flag("--overwrite", run_opt.overwrite, "replace the results in a non-empty output directory");
+  run->add_option("--threads", run_opt.threads, "OpenMP threads (default: all cores)")->check(CLI::Range(1, 1024));
+  run->add_flag("--quiet", run_opt.quiet, "no progress lines");
+
+  std::string check_file;
+  std::vector<std::string> check_sets;
+  auto* check = app.add_subcommand("check", "validate a run file without running it");
+  check->add_option("config", check_file, "run file (YAML)")->required();
+  check->add_option("--set", check_sets, "override a key: path.to.key=value")->allow_extra_args(false);
+
+  std::string kind;
+  bool markdown = false;
+  auto* plugins = app.add_subcommand("plugins", "list plugins with their parameters");
+  plugins->add_option("kind", kind, "only this kind (shape_function, material, ...)");
+  plugins->add_flag("--markdown", markdown, "Markdown output");
+
+  bool schema_md = false;
+  auto* schema = app.add_subcommand("schema", "list the keys of a run file");
+  schema->add_flag("--markdown", schema_md, "Markdown output");
+
+  loam::BenchOptions bench_opt;
+  auto* bench = app.add_subcommand("bench", "throughput benchmark on fixed scenes");
+  bench->add_flag("--json", bench_opt.json, "one JSON object per run, nothing else");
+  bench->add_option("--steps", bench_opt.steps, "timed steps per run")->check(CLI::Range(1, 1000000));
+  bench->add_option("--threads", bench_opt.threads, "thread counts to run (default 1 2)");
+  bench->add_option("--scenes", bench_opt.scenes, "scenes (default: elastic_block_2d elastic_block_3d)");
+  bench->add_option("--update", bench_opt.update, "musl, usl or usf");
+  bench->add_option("--shape-function", bench_opt.shape, "shape function");
+  bench->add_option("--repeat", bench_opt.repeat, "repeat each run and report the median")->check(CLI::Range(1, 20));
+  bench->add_flag("--profile", bench_opt.profile, "print where the step's time goes");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  spdlog::set_pattern("[%H:%M:%S] %^%l%$ %v");
+
+  if (*run) {
+    if (run_opt.quiet) spdlog::set_level(spdlog::level::warn);
+    return loam::run_file(run_file, run_opt);
+  }
+  if (*check) {
+    loam::Diagnostics diag;
+    auto cfg = loam::load_config(check_file, check_sets, diag);
+    if (!diag.ok()) {
+      fputs(diag.format().c_str(), stderr);
+      return 2;
+    }
+    auto r = loam::check_config(cfg);
+    if (r.exit_code) {
+      fputs(r.message.c_str(), stderr);
+      return r.exit_code;
+    }
+    std::printf("%s: ok (%dD, %zu particles, %zu cells)\n", check_file.c_str(), cfg.dimension,
+                r.summary["particles"].get<size_t>(), r.summary["cells"].get<size_t>());
+    return 0;
+  }
+  if (*plugins) {
+    std::string out;
+    bool ok = loam::print_plugins(kind, markdown, out);
+    fputs(out.c_str(), ok ? stdout : stderr);
+    return ok ? 0 : 2;
+  }
+  if (*schema) {
+    fputs(loam::print_config_schema(schema_md).c_str(), stdout);
+    return 0;
+  }
+  if (*bench) return loam::run_bench(bench_opt);
+  return 0;
+}

@@ -1,0 +1,45 @@
+#pragma once
+// Constitutive-model plugin interface. The framework calls update_stress once per contiguous
+// batch of particles of this material (never once per particle), handing it the velocity
+// gradient of the batch. Stress is Cauchy, tension positive, Voigt order xx yy zz xy yz xz.
+#include <limits>
+
+#include "particles.hpp"
+#include "shape_function.hpp"
+
+namespace loam {
+
+class Diagnostics;
+class Params;
+
+template <int D>
+struct MaterialBatch {
+  size_t begin = 0;  // first particle index
+  int count = 0;     // particles in the batch (<= kBlock)
+  double dt = 0;
+  /// Velocity gradient L_ij = dv_i/dx_j of particle begin+p at L[(i*D + j)*kBlock + p].
+  const double* L = nullptr;
+  Particles<D>* particles = nullptr;
+};
+
+template <int D>
+class Material {
+ public:
+  static constexpr const char* kind = "material";
+  virtual ~Material() = default;
+
+  /// Initial mass density (kg/m^3).
+  virtual double density() const = 0;
+  /// Request state fields; `index` is this material's index in particles.material.
+  virtual void setup(Simulation<D>&, int /*index*/, Diagnostics&) {}
+  /// Largest P-wave speed (m/s) of particles [begin, end) for the CFL time step.
+  virtual double wave_speed(const Particles<D>& p, size_t begin, size_t end) const = 0;
+  virtual void update_stress(const MaterialBatch<D>& batch) = 0;
+  /// Stored elastic energy of particles [begin, end) (J, per unit thickness in 2D), or NaN if
+  /// the model does not define one.
+  virtual double strain_energy(const Particles<D>&, size_t, size_t) const {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+};
+
+}  // namespace loam

@@ -1,0 +1,143 @@
+#pragma once
+// Struct-of-arrays particle storage. Every field is a set of contiguous double columns, one per
+// component; a field exists only if some active plugin requested it ("model only what a scene
+// needs"). Hot loops take raw column pointers once per pass.
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace loam {
+
+/// Stress components stored per dimension, Voigt order xx, yy, zz, xy, yz, xz.
+/// 1D keeps the lateral normal stresses (a confined column has sigma_h != 0), 2D is plane strain.
+constexpr int stress_components(int D) { return 3 + D * (D - 1) / 2; }
+
+/// Voigt index of tensor component (i, j) for i, j < 3.
+constexpr int voigt_index(int i, int j) {
+  if (i == j) return i;
+  int a = i < j ? i : j, b = i < j ? j : i;
+  return a == 0 ? (b == 1 ? 3 : 5) : 4;
+}
+
+struct FieldInfo {
+  std::string name;
+  int components = 1;
+  std::string unit;
+  std::string doc;
+  std::vector<std::string> component_names;  // for output ("x", "y", "xx", ...)
+};
+
+template <int D>
+class Particles {
+ public:
+  static constexpr int NS = stress_components(D);
+  // Handles of the fields every scheme uses; requested in the constructor.
+  int position, velocity, mass, volume, stress;
+
+  Particles() {
+    position = request({"position", D, "m", "current position", axis_names()});
+    velocity = request({"velocity", D, "m/s", "velocity", axis_names()});
+    mass = request({"mass", 1, "kg", "mass (per unit thickness in 2D, per unit area in 1D)", {}});
+    volume = request({"volume", 1, "m^D", "current volume", {}});
+    stress = request({"stress", NS, "Pa", "Cauchy stress, tension positive", stress_names()});
+  }
+
+  size_t size() const { return n_; }
+
+  /// Returns the handle of a field, creating it (zero-filled) if needed. Requests with the same
+  /// name must agree on the component count.
+  int request(const FieldInfo& info) {
+    for (size_t f = 0; f < fields_.size(); ++f)
+      if (fields_[f].info.name == info.name) {
+        if (fields_[f].info.components != info.components)
+          throw std::logic_error("field '" + info.name + "' requested with different sizes");
+        return int(f);
+      }
+    Field f{info, std::vector<std::vector<double>>(size_t(info.components))};
+    for (auto& c : f.data) c.assign(n_, 0.0);
+    fields_.push_back(std::move(f));
+    return int(fields_.size() - 1);
+  }
+  int find(const std::string& name) const {
+    for (size_t f = 0; f < fields_.size(); ++f)
+      if (fields_[f].info.name == name) return int(f);
+    return -1;
+  }
+  const FieldInfo& info(int field) const { return fields_[size_t(field)].info; }
+  int num_fields() const { return int(fields_.size()); }
+
+  double* col(int field, int comp = 0) { return fields_[size_t(field)].data[size_t(comp)].data(); }
+  const double* col(int field, int comp = 0) const {
+    return fields_[size_t(field)].data[size_t(comp)].data();
+  }
+  /// Pointers to all components of a field, for kernels.
+  template <int N>
+  std::array<double*, N> cols(int field) {
+    std::array<double*, N> a{};
+    for (int c = 0; c < N; ++c) a[size_t(c)] = col(field, c);
+    return a;
+  }
+
+  // Integer columns: original particle id (stable across sorting), material index, body index.
+  std::vector<uint32_t> id;
+  std::vector<uint16_t> material;
+  std::vector<uint16_t> body;
+
+  void resize(size_t n) {
+    n_ = n;
+    for (auto& f : fields_)
+      for (auto& c : f.data) c.resize(n, 0.0);
+    id.resize(n);
+    material.resize(n);
+    body.resize(n);
+  }
+
+  /// Reorder every column so that new[i] = old[order[i]] (after sorting by cell).
+  void permute(const std::vector<uint32_t>& order) {
+    scratch_.resize(n_);
+    for (auto& f : fields_)
+      for (auto& c : f.data) {
+        for (size_t i = 0; i < n_; ++i) scratch_[i] = c[order[i]];
+        c.swap(scratch_);
+      }
+    permute_int(id, order);
+    permute_int(material, order);
+    permute_int(body, order);
+  }
+
+  size_t bytes_per_particle() const {
+    size_t b = sizeof(uint32_t) + 2 * sizeof(uint16_t);
+    for (const auto& f : fields_) b += sizeof(double) * size_t(f.info.components);
+    return b;
+  }
+
+  static std::vector<std::string> axis_names() {
+    std::vector<std::string> n{"x", "y", "z"};
+    n.resize(D);
+    return n;
+  }
+  static std::vector<std::string> stress_names() {
+    std::vector<std::string> n{"xx", "yy", "zz", "xy", "yz", "xz"};
+    n.resize(NS);
+    return n;
+  }
+
+ private:
+  struct Field {
+    FieldInfo info;
+    std::vector<std::vector<double>> data;
+  };
+  template <class T>
+  void permute_int(std::vector<T>& v, const std::vector<uint32_t>& order) {
+    std::vector<T> out(n_);
+    for (size_t i = 0; i < n_; ++i) out[i] = v[order[i]];
+    v.swap(out);
+  }
+  size_t n_ = 0;
+  std::vector<Field> fields_;
+  std::vector<double> scratch_;
+};
+
+}  // namespace loam

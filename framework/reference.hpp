@@ -1,0 +1,24 @@
+#pragma once
+// Reference (analytic solution) plugin interface, selected by `verify:`. It samples the run as it
+// goes and returns named error metrics, written to summary.json.
+#include <map>
+#include <string>
+
+namespace loam {
+
+template <int D>
+class Simulation;
+class Diagnostics;
+
+template <int D>
+class Reference {
+ public:
+  static constexpr const char* kind = "reference";
+  virtual ~Reference() = default;
+  virtual void setup(Simulation<D>&, Diagnostics&) {}
+  /// Called at the end of every step.
+  virtual void sample(Simulation<D>&) {}
+  virtual std::map<std::string, double> metrics(Simulation<D>&) = 0;
+};
+
+}  // namespace loam

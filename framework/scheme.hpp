@@ -1,0 +1,38 @@
+#pragma once
+// Scheme plugin interface: a scheme owns the order of one explicit step (which quantities go to
+// the grid, how the grid is integrated, what comes back), using the framework's building blocks
+// (stencils, partitioned block loops, boundary/load/damping hooks, material batches).
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace loam {
+
+template <int D>
+class Simulation;
+class Diagnostics;
+
+struct GridFieldView {
+  std::string name;
+  int components;
+  const double* base;  // base[n*stride + offset + c]
+  int stride, offset;
+};
+
+template <int D>
+class Scheme {
+ public:
+  static constexpr const char* kind = "scheme";
+  virtual ~Scheme() = default;
+  /// Request particle fields and allocate node storage.
+  virtual void setup(Simulation<D>&, Diagnostics&) = 0;
+  /// A time-step limit of the scheme's own (e.g. explicit drag), on top of the CFL limit.
+  virtual double stable_dt(const Simulation<D>&) const {
+    return std::numeric_limits<double>::infinity();
+  }
+  virtual void step(Simulation<D>&, double dt) = 0;
+  /// Nodal fields for optional grid output.
+  virtual std::vector<GridFieldView> grid_fields() const { return {}; }
+};
+
+}  // namespace loam

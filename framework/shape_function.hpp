@@ -1,0 +1,72 @@
+#pragma once
+// Shape-function plugin interface. A shape function fills a StencilBlock for up to kBlock
+// consecutive particles: for each particle p and stencil entry k the node index, weight N and
+// gradient dN/dx. Blocks are small enough to stay in L1, and the layout [k][p] lets the
+// evaluation vectorise across particles; only the scatter/gather that follows is scalar.
+#include <cstdint>
+#include <type_traits>
+#include <vector>
+
+#include "grid.hpp"
+#include "particles.hpp"
+
+namespace loam {
+
+template <int D>
+class Simulation;
+class Diagnostics;
+
+constexpr int kBlock = 64;
+
+template <int D>
+struct StencilBlock {
+  int count = 0;  // particles in this block
+  int npp = 0;    // stencil entries per particle
+  std::vector<int32_t> node;  // [k*kBlock + p]
+  std::vector<double> w;      // [k*kBlock + p]
+  std::vector<double> grad;   // [(k*D + d)*kBlock + p]
+
+  void allocate(int nodes_per_particle) {
+    npp = nodes_per_particle;
+    node.assign(size_t(npp) * kBlock, 0);
+    w.assign(size_t(npp) * kBlock, 0.0);
+    grad.assign(size_t(npp) * D * kBlock, 0.0);
+  }
+};
+
+template <int D>
+class ShapeFunction {
+ public:
+  static constexpr const char* kind = "shape_function";
+  virtual ~ShapeFunction() = default;
+
+  /// Stencil entries per particle (entries may carry zero weight).
+  virtual int nodes_per_particle() const = 0;
+  /// Node rows along the slowest axis that a particle in cell row r can touch:
+  /// [r - rows_below(), r + rows_above()]. Used to colour slabs for race-free scatter.
+  virtual int rows_below() const = 0;
+  virtual int rows_above() const = 0;
+  /// Request particle fields (e.g. particle domain sizes) and check the set-up.
+  virtual void setup(Simulation<D>&, Diagnostics&) {}
+  /// Fill `out` for particles [begin, begin + count), count <= kBlock.
+  virtual void evaluate(const Grid<D>& grid, const Particles<D>& particles, size_t begin,
+                        int count, StencilBlock<D>& out) const = 0;
+};
+
+}  // namespace loam
+
+namespace loam {
+
+constexpr int ipow(int b, int e) { return e == 0 ? 1 : b * ipow(b, e - 1); }
+
+/// Call f(std::integral_constant<int, NPP>) with the stencil size as a compile-time constant for
+/// the common sizes (2^D, 3^D, 4^D), so inner loops unroll; NPP = 0 means "use the runtime count".
+template <int D, class F>
+void with_stencil_size(int npp, F&& f) {
+  if (npp == ipow(2, D)) f(std::integral_constant<int, ipow(2, D)>{});
+  else if (npp == ipow(3, D)) f(std::integral_constant<int, ipow(3, D)>{});
+  else if (npp == ipow(4, D)) f(std::integral_constant<int, ipow(4, D)>{});
+  else f(std::integral_constant<int, 0>{});
+}
+
+}  // namespace loam

@@ -1,0 +1,135 @@
+#pragma once
+// The state of one run and the hooks schemes call. A scheme owns the order of a step; this class
+// owns everything else: grid, particles, plugins, time, partition, and the points where boundary
+// conditions, loads and damping act (DESIGN.md "The step, and where plugins hook in").
+#include <omp.h>
+
+#include <array>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "boundary.hpp"
+#include "damping.hpp"
+#include "diagnostics.hpp"
+#include "field.hpp"
+#include "generator.hpp"
+#include "grid.hpp"
+#include "load.hpp"
+#include "material.hpp"
+#include "params.hpp"
+#include "partition.hpp"
+#include "particles.hpp"
+#include "reference.hpp"
+#include "scheme.hpp"
+#include "shape_function.hpp"
+#include "writer.hpp"
+
+namespace loam {
+
+struct Body {
+  std::string name;
+  Params params;
+  size_t first_id = 0, count = 0;    // particle ids [first_id, first_id + count)
+  std::vector<double> lower, upper;  // bounding box of the particles' domains
+  std::vector<double> spacing;       // particle spacing per axis
+};
+
+struct Energies {
+  double kinetic = 0, strain = 0, gravity = 0;
+  std::vector<double> momentum;
+};
+
+template <int D>
+class Simulation {
+ public:
+  using Vec = std::array<double, D>;
+
+  /// Build from a validated config. Semantic errors (particles outside the grid, unknown body
+  /// names, ...) and plugin set-up errors go to `diag`; nothing runs if it is not ok().
+  Simulation(const Params& config, int threads, Diagnostics& diag);
+  ~Simulation();
+
+  Params config;
+  Grid<D> grid;
+  Particles<D> particles;
+  Partition<D> partition;
+  std::unique_ptr<ShapeFunction<D>> shape;
+  std::unique_ptr<Scheme<D>> scheme;
+  std::vector<std::unique_ptr<Material<D>>> materials;  // one per body, index = material id
+  std::vector<Body> bodies;
+  std::vector<std::unique_ptr<Boundary<D>>> boundaries;
+  std::vector<std::unique_ptr<Load<D>>> loads;
+  std::unique_ptr<Damping<D>> damping;
+  std::unique_ptr<Reference<D>> reference;
+
+  Vec gravity{};
+  double time = 0, dt = 0, end_time = 0, cfl = 0.5, fixed_dt = 0;
+  long step = 0;
+  int threads = 1;
+  int sort_every = 20;
+  double mass_tolerance = 1e-12;  // nodes lighter than this (kg) get no velocity
+  double max_speed = 0;           // largest particle speed, maintained by the scheme's gather
+  int external_force = -1;        // particle field handle, or -1 if no load uses it
+  int initial_position = -1;      // for displacement output, or -1
+
+  bool profiling = false;
+  std::map<std::string, double> profile;  // seconds per phase, when profiling
+  /// Run f, adding its wall time to profile[phase] when profiling.
+  template <class F>
+  void timed(const char* phase, F&& f) {
+    if (!profiling) return f();
+    const double t0 = omp_get_wtime();
+    f();
+    profile[phase] += omp_get_wtime() - t0;
+  }
+
+  // --------------------------------------------------------- hooks for schemes
+  /// Apply every boundary condition to a nodal vector.
+  void constrain(const NodalVector& v) const {
+    for (const auto& b : boundaries) b->constrain(v);
+  }
+  void apply_grid_loads(const NodalVector& force) {
+    for (const auto& l : loads) l->apply_to_grid(*this, force, time);
+  }
+  void apply_damping(const NodeForces& nf) {
+    if (damping) damping->apply(*this, nf);
+  }
+  template <class F>
+  void scatter_blocks(F&& f) const { partition.scatter_blocks(std::forward<F>(f)); }
+  template <class F>
+  void gather_blocks(F&& f) const { partition.gather_blocks(std::forward<F>(f)); }
+
+  // --------------------------------------------------------- loop pieces (used by the runner)
+  double stable_dt() const;
+  /// Zero and refill particle external forces from loads (only if a load uses them).
+  void prepare_particle_loads();
+  /// Re-sort particles now.
+  void sort();
+  /// After a step: keep the partition valid and sort periodically.
+  void maintain_partition();
+  Energies energies() const;
+
+  /// Particle index of an original id (valid until the next sort).
+  size_t index_of(uint32_t id) const;
+  /// Ids of particles inside a named particle set; empty name = all. Returns false if unknown.
+  bool particle_set(const std::string& name, std::vector<uint32_t>& ids) const;
+  int body_index(const std::string& name) const;
+
+  /// First particle whose position, velocity or stress is not finite, or that left the grid:
+  /// returns false and fills a description.
+  bool check_particles(std::string& what) const;
+
+ private:
+  void build_grid(const Params& g, Diagnostics& diag);
+  void generate_bodies(Diagnostics& diag);
+  void create_plugins(Diagnostics& diag);
+  std::vector<std::pair<std::string, std::pair<Vec, Vec>>> sets_;
+  mutable std::vector<uint32_t> index_of_id_;
+  mutable bool index_valid_ = false;
+  long last_sort_ = 0;
+};
+
+}  // namespace loam

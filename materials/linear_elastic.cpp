@@ -1,0 +1,85 @@
+// Isotropic linear elasticity, hypoelastic with the Jaumann stress rate:
+//   sigma^{n+1} = sigma^n + (w sigma - sigma w) + lambda tr(d) I + 2 G d,
+// d = sym(L) dt, w = skew(L) dt. Tension positive. 2D is plane strain (sigma_zz from lambda tr d),
+// 1D is laterally confined (sigma_yy = sigma_zz = lambda tr d), as in VERIFICATION.md A.
+#include <cmath>
+
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+#include "framework/tensor.hpp"
+
+namespace loam {
+
+template <int D>
+class LinearElastic : public Material<D> {
+ public:
+  static constexpr const char* name = "linear_elastic";
+  static constexpr const char* summary = "isotropic linear elasticity, Jaumann rate (large rotations)";
+  static Schema schema() {
+    Schema s;
+    s.real("E", "Pa", "Young's modulus").required().positive();
+    s.real("nu", "-", "Poisson's ratio").required().above(-1).below(0.5);
+    s.real("density", "kg/m^3", "mass density").required().positive();
+    return s;
+  }
+  explicit LinearElastic(const Params& p)
+      : E_(p.real("E")), nu_(p.real("nu")), rho_(p.real("density")) {
+    G_ = E_ / (2 * (1 + nu_));
+    lambda_ = E_ * nu_ / ((1 + nu_) * (1 - 2 * nu_));
+    M_ = lambda_ + 2 * G_;  // constrained (P-wave) modulus
+  }
+
+  double density() const override { return rho_; }
+
+  double wave_speed(const Particles<D>& P, size_t b, size_t e) const override {
+    // c_p = sqrt(M / rho); rho grows as particles compress.
+    double rho_max = 0;
+    const double* m = P.col(P.mass);
+    const double* V = P.col(P.volume);
+    for (size_t i = b; i < e; ++i) rho_max = std::max(rho_max, m[i] / V[i]);
+    return std::sqrt(M_ / std::max(rho_max, 1e-300));
+  }
+
+  void update_stress(const MaterialBatch<D>& batch) override {
+    constexpr int NS = Particles<D>::NS;
+    Particles<D>& P = *batch.particles;
+    std::array<double*, NS> s{};
+    for (int c = 0; c < NS; ++c) s[size_t(c)] = P.col(P.stress, c) + batch.begin;
+    for (int p = 0; p < batch.count; ++p) {
+      double d[3][3], w[3][3], sv[NS], sm[3][3], rot[3][3];
+      strain_and_spin<D>(batch.L, kBlock, size_t(p), batch.dt, d, w);
+      for (int c = 0; c < NS; ++c) sv[c] = s[size_t(c)][p];
+      voigt_to_matrix<NS>(sv, sm);
+      jaumann_rotation(w, sm, rot);
+      const double tr = d[0][0] + d[1][1] + d[2][2];
+      for (int c = 0; c < NS; ++c) {
+        static constexpr int I[6] = {0, 1, 2, 0, 1, 0}, J[6] = {0, 1, 2, 1, 2, 2};
+        const int i = I[c], j = J[c];
+        s[size_t(c)][p] = sv[c] + rot[i][j] + 2 * G_ * d[i][j] + (i == j ? lambda_ * tr : 0.0);
+      }
+    }
+  }
+
+  double strain_energy(const Particles<D>& P, size_t b, size_t e) const override {
+    // W = 1/2 sigma : C^-1 : sigma V, with C^-1 from E and nu (3D, all components).
+    constexpr int NS = Particles<D>::NS;
+    const double* V = P.col(P.volume);
+    double sum = 0;
+    for (size_t i = b; i < e; ++i) {
+      double sv[6] = {0, 0, 0, 0, 0, 0};
+      for (int c = 0; c < NS; ++c) sv[c] = P.col(P.stress, c)[i];
+      const double tr = sv[0] + sv[1] + sv[2];
+      double ss = 0;
+      for (int c = 0; c < 6; ++c) ss += (c < 3 ? 1.0 : 2.0) * sv[c] * sv[c];
+      sum += 0.5 * V[i] * ((1 + nu_) * ss - nu_ * tr * tr) / E_;
+    }
+    return sum;
+  }
+
+ private:
+  double E_, nu_, rho_, G_, lambda_, M_;
+};
+
+LOAM_REGISTER(Material, LinearElastic)
+
+}  // namespace loam

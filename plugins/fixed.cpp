@@ -1,0 +1,34 @@
+// Fixed (no-slip) grid face: every velocity component of the face nodes is zero.
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+
+namespace loam {
+
+template <int D>
+class Fixed : public Boundary<D> {
+ public:
+  static constexpr const char* name = "fixed";
+  static constexpr const char* summary = "no-slip grid face: all velocity components zero";
+  static Schema schema() {
+    Schema s;
+    s.choice("face", face_names(), "grid face").required();
+    return s;
+  }
+  explicit Fixed(const Params& p) : params_(p), face_(parse_face(p.text("face"))) {}
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    if (check_face(face_, D, params_, "face", diag)) nodes_ = face_nodes(sim.grid, face_);
+  }
+  void constrain(const NodalVector& v) const override {
+    for (size_t n : nodes_)
+      for (int d = 0; d < D; ++d) v.at(n, d) = 0.0;
+  }
+
+ private:
+  Params params_;
+  Face face_;
+  std::vector<size_t> nodes_;
+};
+
+LOAM_REGISTER(Boundary, Fixed)
+
+}  // namespace loam

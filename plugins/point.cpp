@@ -1,0 +1,62 @@
+// Point force (N; N per unit thickness in 2D) at a fixed position, distributed to the nodes of
+// the cell containing it with linear weights, ramped linearly over ramp_time.
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+
+namespace loam {
+
+template <int D>
+class PointLoad : public Load<D> {
+ public:
+  static constexpr const char* name = "point";
+  static constexpr const char* summary = "point force at a fixed position, spread to its cell's nodes";
+  static Schema schema() {
+    Schema s;
+    s.vector("position", "m", "where the force acts").required();
+    s.vector("force", "N", "force vector").required();
+    s.real("ramp_time", "s", "linear ramp from 0 to full load").def("0").min(0);
+    return s;
+  }
+  explicit PointLoad(const Params& p) : params_(p), ramp_(p.real("ramp_time")) {
+    for (int d = 0; d < D; ++d) {
+      x_[size_t(d)] = p.vec("position")[size_t(d)];
+      f_[size_t(d)] = p.vec("force")[size_t(d)];
+    }
+  }
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    if (!sim.grid.inside(x_)) {
+      diag.error(params_.where("position"), params_.path("position"), "the point is outside the grid");
+      return;
+    }
+    const auto& g = sim.grid;
+    for (int k = 0; k < (1 << D); ++k) {
+      size_t node = 0;
+      double w = 1;
+      for (int d = 0; d < D; ++d) {
+        int c = g.cell_of(x_[size_t(d)], d);
+        double r = (x_[size_t(d)] - g.origin[size_t(d)]) * g.inv_cell[size_t(d)] - c;
+        bool up = (k >> d) & 1;
+        node += size_t(c + (up ? 1 : 0)) * size_t(g.node_stride[d]);
+        w *= up ? r : 1 - r;
+      }
+      nodes_.push_back(node);
+      weights_.push_back(w);
+    }
+  }
+  void apply_to_grid(Simulation<D>&, const NodalVector& force, double t) override {
+    const double s = ramp_factor(t, ramp_);
+    for (size_t k = 0; k < nodes_.size(); ++k)
+      for (int d = 0; d < D; ++d) force.at(nodes_[k], d) += s * weights_[k] * f_[size_t(d)];
+  }
+
+ private:
+  Params params_;
+  double ramp_;
+  std::array<double, D> x_{}, f_{};
+  std::vector<size_t> nodes_;
+  std::vector<double> weights_;
+};
+
+LOAM_REGISTER(Load, PointLoad)
+
+}  // namespace loam

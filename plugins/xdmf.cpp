@@ -1,0 +1,172 @@
+// ParaView output: one HDF5 file per frame (particles_NNNNNN.h5) and one XDMF index
+// (particles.xdmf, a temporal collection of Polyvertex grids). 2D/1D coordinates are padded to
+// XYZ so that ParaView glyph filters work; D-component fields are written as 3-vectors.
+// Every file is written under a temporary name and renamed when complete.
+#include <hdf5.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+
+namespace loam {
+
+template <int D>
+class Xdmf : public Writer<D> {
+ public:
+  static constexpr const char* name = "xdmf";
+  static constexpr const char* summary = "HDF5 per frame + XDMF index, opens in ParaView";
+  static Schema schema() {
+    Schema s;
+    s.boolean("grid", "also write the grid nodes with the scheme's nodal fields").def("false");
+    return s;
+  }
+  explicit Xdmf(const Params& p) : with_grid_(p.flag("grid")) {}
+
+  void open(const std::string& dir, Simulation<D>&, const std::vector<int>& fields) override {
+    dir_ = dir;
+    fields_ = fields;
+  }
+
+  void write(Simulation<D>& sim, const std::string& label) override {
+    const Particles<D>& P = sim.particles;
+    const size_t n = P.size();
+    char name[64];
+    std::snprintf(name, sizeof name, "particles_%06ld%s.h5", long(frames_.size()),
+                  label.empty() ? "" : ("_" + label).c_str());
+    std::filesystem::path file = std::filesystem::path(dir_) / name;
+    std::filesystem::path tmp = file;
+    tmp += ".tmp";
+    hid_t f = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    Frame fr{name, sim.time, sim.step, n, {}, 0, {}};
+    write_columns(f, "position", P, P.position, 3);
+    std::vector<int> ids(n);
+    for (size_t i = 0; i < n; ++i) ids[i] = int(P.id[i]);
+    write_dataset(f, "id", ids.data(), n, 1, H5T_NATIVE_INT);
+    fr.attributes.push_back({"id", 1, "Int"});
+    for (int h : fields_) {
+      const FieldInfo& info = P.info(h);
+      int width = info.components == D && D < 3 ? 3 : info.components;  // pad vectors to 3
+      write_columns(f, info.name, P, h, width);
+      fr.attributes.push_back({info.name, width, "Float"});
+    }
+    if (with_grid_) write_grid(f, sim, fr);
+    H5Fclose(f);
+    std::filesystem::rename(tmp, file);
+    frames_.push_back(fr);
+    write_index();
+  }
+
+ private:
+  struct Attribute {
+    std::string name;
+    int width;
+    std::string number_type;
+  };
+  struct Frame {
+    std::string file;
+    double time;
+    long step;
+    size_t n;
+    std::vector<Attribute> attributes;
+    size_t grid_nodes = 0;
+    std::vector<Attribute> grid_attributes;
+  };
+  std::string dir_;
+  std::vector<int> fields_;
+  std::vector<Frame> frames_;
+  bool with_grid_;
+
+  static void write_dataset(hid_t f, const std::string& name, const void* data, size_t n, int width,
+                            hid_t type) {
+    hsize_t dims[2] = {hsize_t(n), hsize_t(width)};
+    hid_t space = H5Screate_simple(width == 1 ? 1 : 2, dims, nullptr);
+    hid_t ds = H5Dcreate2(f, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (n > 0) H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    H5Dclose(ds);
+    H5Sclose(space);
+  }
+
+  static void write_columns(hid_t f, const std::string& name, const Particles<D>& P, int h, int width) {
+    const size_t n = P.size();
+    const int nc = P.info(h).components;
+    std::vector<double> buf(n * size_t(width), 0.0);
+    for (int c = 0; c < nc; ++c) {
+      const double* col = P.col(h, c);
+      for (size_t i = 0; i < n; ++i) buf[i * size_t(width) + size_t(c)] = col[i];
+    }
+    write_dataset(f, name, buf.data(), n, width, H5T_NATIVE_DOUBLE);
+  }
+
+  void write_grid(hid_t f, Simulation<D>& sim, Frame& fr) {
+    const auto& g = sim.grid;
+    std::vector<double> xyz(g.num_nodes * 3, 0.0);
+    for (size_t n = 0; n < g.num_nodes; ++n)
+      for (int d = 0; d < D; ++d) xyz[n * 3 + size_t(d)] = g.node_coord(n, d);
+    write_dataset(f, "grid_position", xyz.data(), g.num_nodes, 3, H5T_NATIVE_DOUBLE);
+    fr.grid_nodes = g.num_nodes;
+    for (const auto& v : sim.scheme->grid_fields()) {
+      int width = v.components == D && D < 3 ? 3 : v.components;
+      std::vector<double> buf(g.num_nodes * size_t(width), 0.0);
+      for (size_t n = 0; n < g.num_nodes; ++n)
+        for (int c = 0; c < v.components; ++c)
+          buf[n * size_t(width) + size_t(c)] = v.base[n * size_t(v.stride) + size_t(v.offset + c)];
+      write_dataset(f, "grid_" + v.name, buf.data(), g.num_nodes, width, H5T_NATIVE_DOUBLE);
+      fr.grid_attributes.push_back({v.name, width, "Float"});
+    }
+  }
+
+  static std::string attribute_type(int width) {
+    return width == 1 ? "Scalar" : width == 3 ? "Vector" : width == 6 ? "Tensor6" : "Matrix";
+  }
+
+  static void polyvertex(std::ostream& x, const std::string& grid_name, const std::string& file,
+                         const std::string& prefix, size_t n, const std::vector<Attribute>& attrs,
+                         double time) {
+    x << "      <Grid Name=\"" << grid_name << "\" GridType=\"Uniform\">\n"
+      << "        <Time Value=\"" << time << "\"/>\n"
+      << "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n << "\"/>\n"
+      << "        <Geometry GeometryType=\"XYZ\"><DataItem Dimensions=\"" << n
+      << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << file << ":/" << prefix
+      << "position</DataItem></Geometry>\n";
+    for (const auto& a : attrs) {
+      x << "        <Attribute Name=\"" << a.name << "\" AttributeType=\"" << attribute_type(a.width)
+        << "\" Center=\"Node\"><DataItem Dimensions=\"" << n;
+      if (a.width > 1) x << " " << a.width;
+      x << "\" NumberType=\"" << a.number_type << "\" Precision=\"" << (a.number_type == "Int" ? 4 : 8)
+        << "\" Format=\"HDF\">" << file << ":/" << prefix << a.name << "</DataItem></Attribute>\n";
+    }
+    x << "      </Grid>\n";
+  }
+
+  void write_index() {
+    std::ostringstream x;
+    x.precision(12);
+    x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n"
+      << "    <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+    for (const auto& fr : frames_)
+      polyvertex(x, "particles", fr.file, "", fr.n, fr.attributes, fr.time);
+    x << "    </Grid>\n";
+    if (with_grid_) {
+      x << "    <Grid Name=\"grid\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+      for (const auto& fr : frames_)
+        polyvertex(x, "grid", fr.file, "grid_", fr.grid_nodes, fr.grid_attributes, fr.time);
+      x << "    </Grid>\n";
+    }
+    x << "  </Domain>\n</Xdmf>\n";
+    std::filesystem::path file = std::filesystem::path(dir_) / "particles.xdmf";
+    std::filesystem::path tmp = file;
+    tmp += ".tmp";
+    {
+      std::ofstream o(tmp);
+      o << x.str();
+    }
+    std::filesystem::rename(tmp, file);
+  }
+};
+
+LOAM_REGISTER(Writer, Xdmf)
+
+}  // namespace loam
