@@ -101,6 +101,13 @@ Schema config_schema() {
 
 namespace {
 
+/// yaml-cpp's parser message, with a hint where its wording is parser jargon.
+std::string yaml_message(const YAML::Exception& e) {
+  if (e.msg == YAML::ErrorMsg::END_OF_SEQ_FLOW) return e.msg + " (a '[' is not closed or a ',' is missing)";
+  if (e.msg == YAML::ErrorMsg::END_OF_MAP_FLOW) return e.msg + " (a '{' is not closed or a ',' is missing)";
+  return e.msg;
+}
+
 /// Apply `a.b.c=value` to the YAML tree; list elements are addressed by index (bodies.0.name).
 bool apply_override(YAML::Node root, const std::string& arg, const std::string& label,
                     Diagnostics& diag, std::string& path_out) {
@@ -116,7 +123,7 @@ bool apply_override(YAML::Node root, const std::string& arg, const std::string& 
     value = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     diag.error(Location{label, 1, int(eq) + 2 + std::max(0, e.mark.column)}, path,
-               "malformed YAML value: " + e.msg);
+               "malformed YAML value: " + yaml_message(e));
     return false;
   }
   std::vector<std::string> parts;
@@ -227,7 +234,7 @@ LoadedConfig load_config_text(const std::string& text, const std::string& label,
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    diag.error(parse_error_location(e, label), "", "malformed YAML: " + e.msg);
+    diag.error(parse_error_location(e, label), "", "malformed YAML: " + yaml_message(e));
     LoadedConfig out;
     out.file = label;
     return out;

@@ -58,6 +58,13 @@ std::string closest_match(const std::string& word, const std::vector<std::string
   return best_d <= limit ? best : std::string();
 }
 
+std::string suggest(const std::string& word, const std::vector<std::string>& candidates,
+                    const std::string& what) {
+  std::string guess = closest_match(word, candidates);
+  return (guess.empty() ? ";" : "; did you mean '" + guess + "'?") + " " + what + ": " +
+         join(candidates, ", ");
+}
+
 std::string join(const std::vector<std::string>& items, const std::string& sep) {
   std::string out;
   for (size_t i = 0; i < items.size(); ++i) out += (i ? sep : "") + items[i];

@@ -42,6 +42,10 @@ struct ConfigError {
 int edit_distance(const std::string& a, const std::string& b);
 /// Closest candidate within a sensible distance, or "" if none is close.
 std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
+/// The tail of an "unknown name" message: "; did you mean 'b'? <what>: a, b, c", or
+/// "; <what>: a, b, c" when no candidate is close (what: e.g. "valid keys are").
+std::string suggest(const std::string& word, const std::vector<std::string>& candidates,
+                    const std::string& what);
 std::string join(const std::vector<std::string>& items, const std::string& sep);
 
 }  // namespace loam

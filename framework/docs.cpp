@@ -70,10 +70,7 @@ bool print_plugins(const std::string& kind, bool markdown, std::string& out) {
   if (!kind.empty() && !reg.has_kind(kind)) {
     std::vector<std::string> names;
     for (const auto& k : reg.kinds()) names.push_back(k.name);
-    std::string guess = closest_match(kind, names);
-    out = "loam: error: unknown plugin kind '" + kind + "'" +
-          (guess.empty() ? "" : "; did you mean '" + guess + "'?") +
-          " kinds are: " + join(names, ", ") + "\n";
+    out = "loam: error: unknown plugin kind '" + kind + "'" + suggest(kind, names, "kinds are") + "\n";
     return false;
   }
   if (markdown && kind.empty())

@@ -177,10 +177,16 @@ Location Params::where(const std::string& k) const {
   auto it = values_.find(k);
   return it == values_.end() ? where_ : it->second.where;
 }
+Location Params::where(const std::string& k, size_t index) const {
+  auto it = values_.find(k);
+  if (it != values_.end() && index < it->second.items.size()) return it->second.items[index];
+  return where(k);
+}
 
-void Params::set(const std::string& key, Value v, Location where, bool defaulted) {
+void Params::set(const std::string& key, Value v, Location where, bool defaulted,
+                 std::vector<Location> items) {
   if (!values_.count(key)) order_.push_back(key);
-  values_[key] = Entry{std::move(v), std::move(where), defaulted};
+  values_[key] = Entry{std::move(v), std::move(where), defaulted, std::move(items)};
 }
 
 nlohmann::json Params::to_json() const {
@@ -331,11 +337,9 @@ struct Validator {
         }
         for (const auto& c : spec.choices)
           if (c == n.Scalar()) return c;
-        std::string guess = closest_match(n.Scalar(), spec.choices);
         diag.error(loc, path,
                    "unknown value '" + n.Scalar() + "'" +
-                       (guess.empty() ? "" : "; did you mean '" + guess + "'?") +
-                       " valid values are: " + join(spec.choices, ", "));
+                       suggest(n.Scalar(), spec.choices, "valid values are"));
         return {};
       }
       case ParamType::Vector: {
@@ -426,8 +430,15 @@ struct Validator {
         }
         return out;
       }
-      case ParamType::Plugin:
+      case ParamType::Plugin: {
+        // A map without `type:` takes the key's default plugin (e.g. `scheme: {update: usl}`).
+        if (n.IsMap() && !n["type"] && !spec.default_text.empty()) {
+          YAML::Node copy = YAML::Clone(n);
+          copy["type"] = spec.default_text;
+          return std::make_shared<Params>(plugin(copy, spec.plugin_kind, spec.plugin_components, path, loc));
+        }
         return std::make_shared<Params>(plugin(n, spec.plugin_kind, spec.plugin_components, path, loc));
+      }
     }
     return {};
   }
@@ -442,12 +453,10 @@ struct Validator {
       for (auto it = n.begin(); it != n.end(); ++it) {
         std::string key = it->first.IsScalar() ? it->first.Scalar() : "?";
         if (key == extra_key || schema.find(key)) continue;
-        std::string guess = closest_match(key, known);
         diag.error(location_of(it->first, child(key), ctx, loc), child(key),
                    "unknown key '" + key + "'" +
-                       (guess.empty() ? "" : "; did you mean '" + guess + "'?") +
                        (known.empty() ? " (this takes no parameters)"
-                                      : " valid keys are: " + join(known, ", ")));
+                                      : suggest(key, known, "valid keys are")));
       }
     }
     bool all_valid = true;
@@ -458,7 +467,11 @@ struct Validator {
         Location l = location_of(v, p, ctx, loc);
         Params::Value val = value(spec, v, p, l);
         if (std::holds_alternative<std::monostate>(val)) all_valid = false;
-        out.set(spec.key, std::move(val), l);
+        std::vector<Location> items;  // for checks of list elements after validation
+        if (v.IsSequence())
+          for (size_t i = 0; i < v.size(); ++i)
+            items.push_back(location_of(v[i], p + "." + std::to_string(i), ctx, l));
+        out.set(spec.key, std::move(val), l, false, std::move(items));
       } else if (!spec.default_text.empty()) {
         YAML::Node d = YAML::Load(spec.default_text);
         Diagnostics quiet;
@@ -513,11 +526,8 @@ struct Validator {
     const PluginInfo* info = reg.find(kind, name);
     if (!info) {
       auto names = reg.names(kind);
-      std::string guess = closest_match(name, names);
       diag.error(type_loc, n.IsScalar() ? path : type_path,
-                 "unknown " + kind + " '" + name + "'" +
-                     (guess.empty() ? "" : "; did you mean '" + guess + "'?") +
-                     " valid types are: " + join(names, ", "));
+                 "unknown " + kind + " '" + name + "'" + suggest(name, names, "valid types are"));
       return failed;
     }
     int saved = ctx.components;

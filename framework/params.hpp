@@ -115,6 +115,7 @@ class Params {
     Value value;
     Location where;
     bool defaulted = false;
+    std::vector<Location> items;  // of each list element, when given as a list in the file
   };
 
   double real(const std::string& key) const;
@@ -135,11 +136,14 @@ class Params {
   std::string path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
   const Location& where() const { return where_; }
   Location where(const std::string& key) const;
+  /// Location of element `index` of a list value (the list's location if unknown).
+  Location where(const std::string& key, size_t index) const;
 
   nlohmann::json to_json() const;
 
   // Construction (used by the validator and by code that builds configs).
-  void set(const std::string& key, Value v, Location where, bool defaulted = false);
+  void set(const std::string& key, Value v, Location where, bool defaulted = false,
+           std::vector<Location> items = {});
   void set_type(std::string t) { type_ = std::move(t); }
   void set_origin(std::string path, Location where) {
     path_ = std::move(path);

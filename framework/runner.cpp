@@ -112,12 +112,10 @@ class Run {
         for (const auto& g : sim_->scheme->grid_fields()) options.push_back(g.name);
       }
       if (std::find(options.begin(), options.end(), name) != options.end()) return true;
-      std::string guess = closest_match(name, options);
       std::string path = sec.path("fields") + "." + std::to_string(i);
-      diag.error(sec.where("fields"), path,
+      diag.error(sec.where("fields", i), path,
                  "unknown " + std::string(node ? "node" : "particle") + " field '" + name + "'" +
-                     (guess.empty() ? "" : "; did you mean '" + guess + "'?") +
-                     " available fields: " + join(options, ", "));
+                     suggest(name, options, "available fields"));
       return false;
     };
     const Params& out = cfg_.params.section("output");

@@ -67,7 +67,7 @@ void Simulation<D>::build_grid(const Params& g, Diagnostics& diag) {
     h[size_t(d)] = g.vec("cell_size")[size_t(d)];
     double ratio = e[size_t(d)] / h[size_t(d)];
     const char* axis = "xyz" + d;
-    if (std::lround(ratio) < 1) {
+    if (ratio < 1 - 1e-6) {  // not even one whole cell
       diag.error(g.where("cell_size"), g.path("cell_size"),
                  std::string("the grid has zero cells along ") + axis[0] + " (extent " +
                      format_number(e[size_t(d)]) + " m < cell_size " + format_number(h[size_t(d)]) + " m)");

@@ -51,7 +51,7 @@ class ElasticColumn : public Reference<D> {
     const auto& P = sim.particles;
     const int v_comp = D - 1;             // Voigt index of sigma along the last axis
     const int h_comp = D == 1 ? 1 : 0;    // a lateral normal stress
-    double e2 = 0, r2 = 0, h2 = 0, hr2 = 0, u2 = 0, ur2 = 0, top_u = 0, top_z = -1e300;
+    double mean_sv = 0, vol = 0, e2 = 0, r2 = 0, h2 = 0, hr2 = 0, u2 = 0, ur2 = 0, top_u = 0, top_z = -1e300;
     for (size_t i = 0; i < P.size(); ++i) {
       if (P.body[i] != body_) continue;
       const double V = P.col(P.volume)[i];
@@ -60,6 +60,8 @@ class ElasticColumn : public Reference<D> {
       const double sh = nu_ / (1 - nu_) * sv;
       const double uz = -rho_ * g_ * (H_ * z - 0.5 * z * z) / M_;
       const double u = P.col(P.position, D - 1)[i] - P.col(z0_, D - 1)[i];
+      mean_sv += V * P.col(P.stress, v_comp)[i];
+      vol += V;
       e2 += V * std::pow(P.col(P.stress, v_comp)[i] - sv, 2);
       r2 += V * sv * sv;
       h2 += V * std::pow(P.col(P.stress, h_comp)[i] - sh, 2);
@@ -72,6 +74,7 @@ class ElasticColumn : public Reference<D> {
     m["stress_error_l2"] = std::sqrt(e2 / r2);
     m["horizontal_stress_error_l2"] = hr2 > 0 ? std::sqrt(h2 / hr2) : std::sqrt(h2 / r2);
     m["displacement_error_l2"] = std::sqrt(u2 / ur2);
+    m["mean_vertical_stress"] = mean_sv / vol;  // for comparing 1D, 2D and 3D runs
     m["settlement_exact"] = rho_ * g_ * H_ * H_ / (2 * M_);
     m["settlement_top_particle"] = -top_u;
     return m;
