@@ -12,6 +12,7 @@
 namespace loam {
 
 Schema config_schema() {
+  const Registry& reg = Registry::instance();
   Schema s;
   s.string_list("plugins", "shared libraries with out-of-tree plugins, loaded before validation");
   {
@@ -26,9 +27,11 @@ Schema config_schema() {
         .scalar_ok();
     s.section("grid", g, "background grid").required();
   }
-  s.plugin("shape_function", "shape_function", "interpolation between particles and nodes").def("linear");
+  // Defaults are whatever plugin declared itself the default of its kind; the core names none.
+  s.plugin("shape_function", "shape_function", "interpolation between particles and nodes")
+      .def(reg.default_of("shape_function"));
   s.plugin("scheme", "scheme", "what one explicit step does (mixture formulation, update order)")
-      .def("single_phase");
+      .def(reg.default_of("scheme"));
   s.vector("gravity", "m/s^2", "gravitational acceleration").def("0").scalar_ok();
   {
     Schema b;
@@ -67,7 +70,7 @@ Schema config_schema() {
     o.real("every_time", "s", "write a frame every T seconds of simulated time").positive();
     o.string_list("fields", "particle fields to write besides position (see `loam fields`)")
         .def("[velocity, stress]");
-    o.plugin("writer", "writer", "output format").def("xdmf");
+    o.plugin("writer", "writer", "output format").def(reg.default_of("writer"));
     o.integer("history_every", "write energies and momentum to history.csv every N steps (0: at frames)")
         .def("0")
         .min(0);

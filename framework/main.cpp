@@ -4,7 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
-#include "bench.hpp"
+#include "bench/bench.hpp"
 #include "config.hpp"
 #include "docs.hpp"
 #include "runner.hpp"

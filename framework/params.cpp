@@ -503,10 +503,11 @@ struct Validator {
     std::string type_path = path + ".type";
     if (n.IsScalar()) {
       name = n.Scalar();
-    } else if (n.IsSequence() && reg.find(kind, "constant")) {
-      // A bare list for a field means a constant value: [0, -9.81] == {type: constant, value: [...]}
+    } else if (n.IsSequence() && !reg.list_shorthand(kind).empty()) {
+      // A bare list stands for the kind's shorthand plugin, e.g. for fields a constant value:
+      // [0, -9.81] == {type: constant, value: [0, -9.81]}.
       YAML::Node m;
-      m["type"] = "constant";
+      m["type"] = reg.list_shorthand(kind);
       m["value"] = n;
       return plugin(m, kind, components, path, loc);
     } else if (n.IsMap()) {

@@ -43,6 +43,16 @@ std::vector<std::string> Registry::names(const std::string& kind) const {
   return out;
 }
 
+std::string Registry::default_of(const std::string& kind) const {
+  auto it = defaults_.find(kind);
+  return it == defaults_.end() ? "" : it->second;
+}
+
+std::string Registry::list_shorthand(const std::string& kind) const {
+  auto it = shorthand_.find(kind);
+  return it == shorthand_.end() ? "" : it->second;
+}
+
 std::string load_plugin_library(const std::string& path) {
   Registry& reg = Registry::instance();
   reg.loading_origin = path;

@@ -55,16 +55,25 @@ class Registry {
     return std::any_cast<const Factory&>(info->factories[D - 1])(p);
   }
 
+  /// The plugin used when a config omits a key of this kind (declared by the plugin itself with
+  /// LOAM_REGISTER_DEFAULT), or "".
+  std::string default_of(const std::string& kind) const;
+  void set_default(const std::string& kind, const std::string& name) { defaults_[kind] = name; }
+  /// The plugin a bare YAML list stands for in this kind (fields: a constant value), or "".
+  std::string list_shorthand(const std::string& kind) const;
+  void set_list_shorthand(const std::string& kind, const std::string& name) { shorthand_[kind] = name; }
+
   /// Label attached to plugins registered while loading a shared library.
   std::string loading_origin = "built-in";
 
  private:
   std::vector<KindInfo> kinds_;
   std::map<std::string, std::map<std::string, PluginInfo>> plugins_;
+  std::map<std::string, std::string> defaults_, shorthand_;
 };
 
 template <template <int> class Base, template <int> class Impl>
-bool register_plugin() {
+bool register_plugin(bool as_default = false) {
   PluginInfo info;
   info.kind = Base<1>::kind;
   info.name = Impl<1>::name;
@@ -76,6 +85,7 @@ bool register_plugin() {
       [](const Params& p) { return std::make_unique<Impl<2>>(p); });
   info.factories[2] = std::function<std::unique_ptr<Base<3>>(const Params&)>(
       [](const Params& p) { return std::make_unique<Impl<3>>(p); });
+  if (as_default) Registry::instance().set_default(info.kind, info.name);
   Registry::instance().add(std::move(info));
   return true;
 }
@@ -93,6 +103,17 @@ std::string load_plugin_library(const std::string& path);
   namespace {                                                                   \
   [[maybe_unused]] const bool LOAM_CONCAT(loam_registered_, IMPL) =             \
       ::loam::register_plugin<::loam::BASE, IMPL>();                            \
+  }
+/// Register a plugin and make it the one used when a config omits its key.
+#define LOAM_REGISTER_DEFAULT(BASE, IMPL)                                       \
+  namespace {                                                                   \
+  [[maybe_unused]] const bool LOAM_CONCAT(loam_registered_, IMPL) =             \
+      ::loam::register_plugin<::loam::BASE, IMPL>(true);                        \
+  }
+#define LOAM_REGISTER_KIND_SHORTHAND(KIND, NAME)                                   \
+  namespace {                                                                      \
+  [[maybe_unused]] const bool LOAM_CONCAT(loam_shorthand_, __LINE__) =             \
+      (::loam::Registry::instance().set_list_shorthand(KIND, NAME), true);         \
   }
 #define LOAM_REGISTER_KIND(KIND, DOC)                                              \
   namespace {                                                                      \

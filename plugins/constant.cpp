@@ -24,5 +24,7 @@ class Constant : public Field<D> {
 };
 
 LOAM_REGISTER(Field, Constant)
+// A bare YAML list in a field-valued key means this plugin.
+LOAM_REGISTER_KIND_SHORTHAND("field", "constant")
 
 }  // namespace loam

@@ -167,6 +167,6 @@ class Xdmf : public Writer<D> {
   }
 };
 
-LOAM_REGISTER(Writer, Xdmf)
+LOAM_REGISTER_DEFAULT(Writer, Xdmf)
 
 }  // namespace loam

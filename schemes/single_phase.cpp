@@ -342,6 +342,6 @@ class SinglePhase : public Scheme<D> {
   }
 };
 
-LOAM_REGISTER(Scheme, SinglePhase)
+LOAM_REGISTER_DEFAULT(Scheme, SinglePhase)
 
 }  // namespace loam

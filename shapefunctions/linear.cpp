@@ -58,6 +58,6 @@ class Linear : public ShapeFunction<D> {
   }
 };
 
-LOAM_REGISTER(ShapeFunction, Linear)
+LOAM_REGISTER_DEFAULT(ShapeFunction, Linear)
 
 }  // namespace loam

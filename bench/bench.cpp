@@ -1,4 +1,4 @@
-// Throughput benchmark: an elastic block under gravity on a fixed base, ~100k particles, a fixed
+// Throughput benchmark (not part of the core: its scenes name concrete plugins): an elastic block under gravity on a fixed base, ~100k particles, a fixed
 // number of steps after a short warm-up, reported as particle-steps per second (DESIGN.md: speed
 // lives in benchmarks, never in timed unit tests).
 #include "bench.hpp"
@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "config.hpp"
-#include "runner.hpp"
+#include "framework/config.hpp"
+#include "framework/runner.hpp"
 
 namespace loam {
 

@@ -1,0 +1,35 @@
+// The core names no concrete plugin: framework/ includes nothing from the plugin directories and
+// no framework source spells a registered plugin's name as a string literal (DESIGN.md).
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "framework/registry.hpp"
+
+namespace fs = std::filesystem;
+
+TEST_CASE("framework/ includes nothing from plugin directories and names no plugin", "[layout]") {
+  std::vector<std::string> names;
+  for (const auto& k : loam::Registry::instance().kinds())
+    for (const auto& n : loam::Registry::instance().names(k.name)) names.push_back(n);
+  REQUIRE(names.size() >= 15);
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(fs::path(LOAM_SOURCE_DIR) / "framework")) {
+    std::string ext = e.path().extension().string();
+    if (ext != ".cpp" && ext != ".hpp" && ext != ".in") continue;
+    ++files;
+    std::ifstream in(e.path());
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string text = ss.str();
+    INFO(e.path().filename().string());
+    for (const char* dir : {"materials/", "shapefunctions/", "schemes/", "plugins/"})
+      CHECK(text.find(std::string("#include \"") + dir) == std::string::npos);
+    for (const auto& n : names) {
+      INFO("plugin name " << n);
+      CHECK(text.find("\"" + n + "\"") == std::string::npos);
+    }
+  }
+  CHECK(files > 10);
+}

@@ -1,0 +1,82 @@
+// Run contract: output files, probes, the unstable-run stop (exit 3), overrides in the summary.
+#include <catch2/catch.hpp>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "cli.hpp"
+
+using loam_test::run_loam;
+using loam_test::TempDir;
+
+static std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST_CASE("a run writes XDMF frames, probes, history and a complete summary", "[output]") {
+  TempDir dir("output");
+  auto r = run_loam(std::string("run ") + LOAM_SOURCE_DIR +
+                    "/configs/vibrating_bar.yaml --quiet --set time.end=20 --out " + dir.path.string());
+  REQUIRE(r.exit_code == 0);
+  auto s = nlohmann::json::parse(slurp(dir.path / "summary.json"));
+  for (const char* key : {"loam_version", "git_commit", "config", "dimension", "particles", "cells",
+                          "steps", "end_time", "wall_seconds", "threads",
+                          "particle_steps_per_second", "verify"})
+    CHECK(s.contains(key));
+  CHECK(s["config"]["time"]["end"].get<double>() == 20.0);  // echo after overrides
+  CHECK(s["config"]["scheme"]["update"] == "musl");         // and with defaults filled in
+  CHECK(s["end_time"].get<double>() == Approx(20.0));
+  // Frames every 1 s for 20 s, plus t = 0.
+  std::string xdmf = slurp(dir.path / "particles.xdmf");
+  size_t frames = 0;
+  for (size_t pos = 0; (pos = xdmf.find("<Time Value", pos)) != std::string::npos; ++pos) ++frames;
+  CHECK(frames == 21);
+  CHECK(std::filesystem::exists(dir.path / "particles_000020.h5"));
+  // The tip probe samples every step: a header plus steps + 1 rows.
+  std::ifstream probe(dir.path / "probe_tip.csv");
+  std::string header, line;
+  std::getline(probe, header);
+  CHECK(header == "step,time,position,velocity,displacement,stress_xx,stress_yy,stress_zz");
+  long rows = 0;
+  while (std::getline(probe, line)) ++rows;
+  CHECK(rows == s["steps"].get<long>() + 1);
+  // No temporary files are left behind.
+  for (const auto& e : std::filesystem::directory_iterator(dir.path))
+    CHECK(e.path().extension() != ".tmp");
+}
+
+TEST_CASE("an unstable run stops with exit 3 naming step, time, particle and field", "[output]") {
+  // A fixed time step 100x above the CFL limit makes the column explode.
+  TempDir dir("unstable");
+  auto r = run_loam(std::string("run ") + LOAM_SOURCE_DIR +
+                    "/configs/elastic_column_1d.yaml --quiet --set time.dt=0.01 --out " +
+                    dir.path.string());
+  INFO(r.output);
+  CHECK(r.exit_code == 3);
+  std::regex pattern(R"(loam: error: unstable run at step \d+, t = [0-9.e+-]+ s: particle \d+ \(body 'column'\): (position|velocity|stress)\S* .*)");
+  CHECK(std::regex_search(r.output, pattern));
+  auto s = nlohmann::json::parse(slurp(dir.path / "summary.json"));
+  CHECK(s["status"] == "unstable");
+  bool failed_frame = false;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path))
+    failed_frame = failed_frame || e.path().filename().string().find("_failed.h5") != std::string::npos;
+  CHECK(failed_frame);
+}
+
+TEST_CASE("loam check validates without writing; plugins lists every kind", "[output]") {
+  auto r = run_loam(std::string("check ") + LOAM_SOURCE_DIR + "/configs/elastic_column_3d.yaml");
+  CHECK(r.exit_code == 0);
+  CHECK(r.output.find("ok (3D, 5120 particles, 672 cells)") != std::string::npos);
+  auto p = run_loam("plugins");
+  CHECK(p.exit_code == 0);
+  for (const char* kind : {"shape_function", "material", "scheme", "boundary", "load", "damping",
+                           "reference", "writer"})
+    CHECK(p.output.find(std::string(kind) + " — ") != std::string::npos);
+  CHECK(p.output.find("E  (real, Pa, required, range (0, inf))") != std::string::npos);
+  auto bad = run_loam("plugins materail");
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.output.find("did you mean 'material'?") != std::string::npos);
+}
