@@ -66,7 +66,7 @@ class Run {
     Diagnostics diag;
     int threads = opt_.threads > 0 ? opt_.threads : omp_get_max_threads();
     sim_ = std::make_unique<Simulation<D>>(cfg_.params, threads, diag);
-    if (diag.ok()) check_outputs(diag);
+    if (sim_->model_checked) check_outputs(diag);
     if (sim_) sim_->profiling = opt_.profile;
     if (!diag.ok()) {
       res.exit_code = 2;

@@ -31,10 +31,13 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
     for (int d = 0; d < D; ++d) lo[size_t(d)] = s.vec("min")[size_t(d)], hi[size_t(d)] = s.vec("max")[size_t(d)];
     sets_.push_back({s.text("name"), {lo, hi}});
   }
+  // From here on, keep checking after an error wherever the rest does not depend on it, so that
+  // one run reports every problem at once.
   create_plugins(diag);
-  if (!diag.ok()) return;
+  const size_t errors_before = diag.errors().size();
   generate_bodies(diag);
-  if (!diag.ok()) return;
+  const bool particles_ok = diag.errors().size() == errors_before;
+  if (!particles_ok) particles.resize(0);  // check the remaining set-up on an empty model
   // Plugins see the generated particles in set-up (e.g. to select faces or request fields).
   shape->setup(*this, diag);
   scheme->setup(*this, diag);
@@ -44,9 +47,10 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   if (particle_loads)
     external_force = particles.request({"external_force", D, "N", "applied external force",
                                         Particles<D>::axis_names()});
-  if (!diag.ok()) return;
   sort();
   for (auto& b : boundaries) b->setup(*this, diag);
+  model_checked = true;
+  if (!particles_ok) return;  // loads and references select particles
   for (auto& l : loads) l->setup(*this, diag);
   if (reference) reference->setup(*this, diag);
   if (!diag.ok()) return;
@@ -102,6 +106,7 @@ template <int D>
 void Simulation<D>::generate_bodies(Diagnostics& diag) {
   Registry& reg = Registry::instance();
   const auto& bl = config.list("bodies");
+  const size_t errors_before = diag.errors().size();
   std::vector<Vec> xs;
   std::vector<uint16_t> owner;
   std::vector<double> vols;
@@ -180,7 +185,7 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
     body.spacing.assign(s.begin(), s.end());
     bodies.push_back(std::move(body));
   }
-  if (!diag.ok()) return;
+  if (diag.errors().size() != errors_before) return;
   const size_t n = xs.size();
   if (n > size_t(UINT32_MAX)) {
     diag.error(config.where("bodies"), "bodies", "more than 2^32 particles");

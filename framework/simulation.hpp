@@ -74,6 +74,7 @@ class Simulation {
   double max_speed = 0;           // largest particle speed, maintained by the scheme's gather
   int external_force = -1;        // particle field handle, or -1 if no load uses it
   int initial_position = -1;      // for displacement output, or -1
+  bool model_checked = false;     // grid and plugins were set up (output checks may run)
 
   bool profiling = false;
   std::map<std::string, double> profile;  // seconds per phase, when profiling

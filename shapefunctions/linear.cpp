@@ -21,37 +21,46 @@ class Linear : public ShapeFunction<D> {
                 StencilBlock<D>& out) const override {
     constexpr int K = 1 << D;
     out.count = count;
-    std::array<const double*, D> x{};
-    for (int d = 0; d < D; ++d) x[size_t(d)] = P.col(P.position, d) + begin;
-    for (int p = 0; p < count; ++p) {
-      double n0[D], n1[D];
-      long base = 0;
-      for (int d = 0; d < D; ++d) {
-        const double xi = (x[size_t(d)][p] - g.origin[size_t(d)]) * g.inv_cell[size_t(d)];
+    // Per-axis weights first (vectorises across particles), then the 2^D tensor products,
+    // node-major so that each inner loop runs over contiguous particles.
+    alignas(64) double n0[D][kBlock], n1[D][kBlock];
+    alignas(64) int32_t base[kBlock];
+    for (int p = 0; p < count; ++p) base[p] = 0;
+    for (int d = 0; d < D; ++d) {
+      const double* x = P.col(P.position, d) + begin;
+      const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
+      const int last = g.cells[d] - 1;
+      const int32_t stride = int32_t(g.node_stride[d]);
+      for (int p = 0; p < count; ++p) {
+        const double xi = (x[p] - o) * ih;
         int c = int(xi);
-        c = c < 0 ? 0 : (c >= g.cells[d] ? g.cells[d] - 1 : c);  // stay inside the grid
+        c = c < 0 ? 0 : (c > last ? last : c);  // stay inside the grid
         const double r = xi - c;
-        n0[d] = 1.0 - r;
-        n1[d] = r;
-        base += long(c) * g.node_stride[d];
+        n0[d][p] = 1.0 - r;
+        n1[d][p] = r;
+        base[p] += c * stride;
       }
-      for (int k = 0; k < K; ++k) {
-        long node = base;
-        double w = 1.0;
-        for (int d = 0; d < D; ++d) {
-          const bool up = (k >> d) & 1;
-          node += up ? g.node_stride[d] : 0;
-          w *= up ? n1[d] : n0[d];
-        }
-        const size_t kp = size_t(k) * kBlock + size_t(p);
-        out.node[kp] = int32_t(node);
-        out.w[kp] = w;
-        for (int d = 0; d < D; ++d) {
-          // dN/dx_d = (+-1/h_d) * product of the other axes' weights
-          double gd = ((k >> d) & 1 ? 1.0 : -1.0) * g.inv_cell[size_t(d)];
+    }
+    for (int k = 0; k < K; ++k) {
+      int32_t offset = 0;
+      for (int d = 0; d < D; ++d) offset += (k >> d) & 1 ? int32_t(g.node_stride[d]) : 0;
+      int32_t* node = out.node.data() + size_t(k) * kBlock;
+      double* w = out.w.data() + size_t(k) * kBlock;
+      for (int p = 0; p < count; ++p) {
+        node[p] = base[p] + offset;
+        double wp = 1.0;
+        for (int d = 0; d < D; ++d) wp *= (k >> d) & 1 ? n1[d][p] : n0[d][p];
+        w[p] = wp;
+      }
+      for (int d = 0; d < D; ++d) {
+        // dN/dx_d = (+-1/h_d) * product of the other axes' weights
+        const double sign_ih = ((k >> d) & 1 ? 1.0 : -1.0) * g.inv_cell[size_t(d)];
+        double* gr = out.grad.data() + (size_t(k) * D + size_t(d)) * kBlock;
+        for (int p = 0; p < count; ++p) {
+          double gp = sign_ih;
           for (int e = 0; e < D; ++e)
-            if (e != d) gd *= (k >> e) & 1 ? n1[e] : n0[e];
-          out.grad[(size_t(k) * D + size_t(d)) * kBlock + size_t(p)] = gd;
+            if (e != d) gp *= (k >> e) & 1 ? n1[e][p] : n0[e][p];
+          gr[p] = gp;
         }
       }
     }

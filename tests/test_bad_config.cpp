@@ -34,7 +34,9 @@ std::string read_text(const fs::path& p) {
   return s.str();
 }
 
-void write_text(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+void write_text(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
 
 /// One expected diagnostic line (without the newline).
 std::string error_line(const std::string& file, int line, int col, const std::string& path,
@@ -63,7 +65,8 @@ class Scratch {
   fs::path out() const { return dir_ / "out"; }
 
   /// `FILE:LINE:COL: error: path: message` with FILE the run file.
-  std::string error_at(int line, int col, const std::string& path, const std::string& message) const {
+  std::string error_at(int line, int col, const std::string& path,
+                       const std::string& message) const {
     return error_line(config().string(), line, col, path, message);
   }
 
@@ -77,7 +80,7 @@ class Scratch {
   Outcome run_file(const fs::path& file, const std::vector<std::string>& args = {}) const {
     std::string cmd = std::string(LOAM_EXE) + " run " + quoted(file.string()) + " --out " +
                       quoted(out().string()) + " --quiet";
-    for (const auto& a : args) cmd += " " + quoted(a);
+    for (const auto& a : args) cmd.append(" ").append(quoted(a));
     cmd += " 2>&1 >/dev/null";  // stderr into the pipe, stdout discarded
     Outcome r;
     FILE* pipe = popen(cmd.c_str(), "r");
@@ -102,7 +105,7 @@ void require_rejected(const Scratch& s, const Outcome& r, const std::vector<std:
   CHECK_FALSE(fs::exists(s.out()));
 }
 
-const char* const kTopKeys =
+const std::string kTopKeys =
     "plugins, grid, shape_function, scheme, gravity, bodies, particle_sets, boundaries, loads, "
     "damping, time, output, probes, verify, numerics";
 
@@ -122,9 +125,10 @@ time:
 outptu:
   every_time: 0.01
 )");
-  require_rejected(s, r, {s.error_at(10, 1, "outptu",
-                                     std::string("unknown key 'outptu'; did you mean 'output'? "
-                                                 "valid keys are: ") + kTopKeys)});
+  require_rejected(
+      s, r,
+      {s.error_at(10, 1, "outptu",
+                  "unknown key 'outptu'; did you mean 'output'? valid keys are: " + kTopKeys)});
 }
 
 TEST_CASE("unknown key with no close match still lists the valid keys", "[bad_config]") {
@@ -140,8 +144,8 @@ time:
   end: 0.1
   steps: 100
 )");
-  require_rejected(s, r, {s.error_at(10, 3, "time.steps",
-                                     "unknown key 'steps'; valid keys are: end, cfl, dt")});
+  require_rejected(
+      s, r, {s.error_at(10, 3, "time.steps", "unknown key 'steps'; valid keys are: end, cfl, dt")});
 }
 
 TEST_CASE("misspelt key inside a body: unknown key and the missing one", "[bad_config]") {
@@ -192,8 +196,9 @@ bodies:
 time:
   end: 0.1
 )");
-  require_rejected(s, r, {s.error_at(6, 33, "bodies.0.generator.min",
-                                     "expected 2 components (the grid is 2D), got 3")});
+  require_rejected(s, r,
+                   {s.error_at(6, 33, "bodies.0.generator.min",
+                               "expected 2 components (the grid is 2D), got 3")});
 }
 
 TEST_CASE("Poisson's ratio of 0.5 is out of range", "[bad_config]") {
@@ -251,8 +256,9 @@ bodies:
 time:
   end: 0.1
 )");
-  require_rejected(s, r, {s.error_at(8, 7, "bodies.0.material.E",
-                                     "missing required key 'E' (Young's modulus, Pa)")});
+  require_rejected(
+      s, r,
+      {s.error_at(8, 7, "bodies.0.material.E", "missing required key 'E' (Young's modulus, Pa)")});
 }
 
 TEST_CASE("a plugin map without type lists the valid types", "[bad_config]") {
@@ -287,9 +293,10 @@ bodies:
 time:
   end: 0.1
 )");
-  require_rejected(s, r, {s.error_at(4, 17, "shape_function",
-                                     "unknown shape_function 'lineer'; did you mean 'linear'? "
-                                     "valid types are: linear")});
+  require_rejected(s, r,
+                   {s.error_at(4, 17, "shape_function",
+                               "unknown shape_function 'lineer'; did you mean 'linear'? "
+                               "valid types are: linear")});
 }
 
 TEST_CASE("an unknown choice value suggests the closest one", "[bad_config]") {
@@ -305,9 +312,10 @@ bodies:
 time:
   end: 0.1
 )");
-  require_rejected(s, r, {s.error_at(4, 38, "scheme.update",
-                                     "unknown value 'mus'; did you mean 'musl'? valid values are: "
-                                     "musl, usl, usf")});
+  require_rejected(s, r,
+                   {s.error_at(4, 38, "scheme.update",
+                               "unknown value 'mus'; did you mean 'musl'? valid values are: "
+                               "musl, usl, usf")});
 }
 
 TEST_CASE("malformed YAML: an unclosed bracket", "[bad_config]") {
@@ -323,9 +331,10 @@ time:
   end: 0.1
 )");
   // yaml-cpp notices the missing ']' at the ':' after cell_size, still inside the list.
-  require_rejected(s, r, {s.error_at(3, 12, "<document>",
-                                     "malformed YAML: end of sequence flow not found (a '[' is "
-                                     "not closed or a ',' is missing)")});
+  require_rejected(s, r,
+                   {s.error_at(3, 12, "<document>",
+                               "malformed YAML: end of sequence flow not found (a '[' is "
+                               "not closed or a ',' is missing)")});
 }
 
 TEST_CASE("a run file that does not exist", "[bad_config]") {
@@ -347,9 +356,10 @@ bodies:
 time:
   end: 0.1
 )");
-  require_rejected(s, r, {s.error_at(6, 16, "bodies.0.generator",
-                                     "particles outside the grid: the body spans [0] to [5] but "
-                                     "the grid spans [0] to [4]")});
+  require_rejected(s, r,
+                   {s.error_at(6, 16, "bodies.0.generator",
+                               "particles outside the grid: the body spans [0] to [5] but "
+                               "the grid spans [0] to [4]")});
 }
 
 TEST_CASE("a cell larger than the grid leaves zero cells", "[bad_config]") {
@@ -364,8 +374,9 @@ bodies:
 time:
   end: 0.1
 )");
-  require_rejected(s, r, {s.error_at(3, 14, "grid.cell_size",
-                                     "the grid has zero cells along x (extent 4 m < cell_size 5 m)")});
+  require_rejected(s, r,
+                   {s.error_at(3, 14, "grid.cell_size",
+                               "the grid has zero cells along x (extent 4 m < cell_size 5 m)")});
 }
 
 TEST_CASE("two errors are both reported, in file order", "[bad_config]") {
@@ -399,8 +410,9 @@ time:
   end: 0.1
 )",
                  {"--set", "bodies.0.material.nu=0.6"});
-  require_rejected(s, r, {error_line("<--set bodies.0.material.nu=0.6>", 1, 1, "bodies.0.material.nu",
-                                     "0.6 is out of range (-1, 0.5)")});
+  require_rejected(s, r,
+                   {error_line("<--set bodies.0.material.nu=0.6>", 1, 1, "bodies.0.material.nu",
+                               "0.6 is out of range (-1, 0.5)")});
 }
 
 TEST_CASE("a boundary face that does not exist in 1D", "[bad_config]") {
@@ -417,8 +429,9 @@ boundaries:
 time:
   end: 0.1
 )");
-  require_rejected(s, r, {s.error_at(9, 25, "boundaries.0.face",
-                                     "face 'y-' does not exist in 1D (faces: x-, x+)")});
+  require_rejected(
+      s, r,
+      {s.error_at(9, 25, "boundaries.0.face", "face 'y-' does not exist in 1D (faces: x-, x+)")});
 }
 
 TEST_CASE("an unknown particle field in output.fields is located at the element", "[bad_config]") {
@@ -437,10 +450,11 @@ output:
     - velocity
     - strees
 )");
-  require_rejected(s, r, {s.error_at(13, 7, "output.fields.1",
-                                     "unknown particle field 'strees'; did you mean 'stress'? "
-                                     "available fields: position, velocity, mass, volume, stress, "
-                                     "displacement")});
+  require_rejected(s, r,
+                   {s.error_at(13, 7, "output.fields.1",
+                               "unknown particle field 'strees'; did you mean 'stress'? "
+                               "available fields: position, velocity, mass, volume, stress, "
+                               "displacement")});
 }
 
 TEST_CASE("a probe naming both particle_near and node", "[bad_config]") {
@@ -459,8 +473,8 @@ probes:
     particle_near: [2]
     node: [2]
 )");
-  require_rejected(s, r, {s.error_at(11, 5, "probes.0",
-                                     "give exactly one of 'particle_near' or 'node'")});
+  require_rejected(
+      s, r, {s.error_at(11, 5, "probes.0", "give exactly one of 'particle_near' or 'node'")});
 }
 
 TEST_CASE("a non-empty output directory is not touched without --overwrite", "[bad_config]") {
