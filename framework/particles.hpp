@@ -2,6 +2,8 @@
 // Struct-of-arrays particle storage. Every field is a set of contiguous double columns, one per
 // component; a field exists only if some active plugin requested it ("model only what a scene
 // needs"). Hot loops take raw column pointers once per pass.
+#include <omp.h>
+
 #include <array>
 #include <cstdint>
 #include <stdexcept>
@@ -95,13 +97,21 @@ class Particles {
   }
 
   /// Reorder every column so that new[i] = old[order[i]] (after sorting by cell).
-  void permute(const std::vector<uint32_t>& order) {
-    scratch_.resize(n_);
+  void permute(const std::vector<uint32_t>& order, int threads = 1) {
+    // Columns are independent: permute them in parallel, one scratch column per thread.
+    std::vector<std::vector<double>*> columns;
     for (auto& f : fields_)
-      for (auto& c : f.data) {
-        for (size_t i = 0; i < n_; ++i) scratch_[i] = c[order[i]];
-        c.swap(scratch_);
-      }
+      for (auto& c : f.data) columns.push_back(&c);
+    scratch_.resize(size_t(threads));
+    const int nc = int(columns.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int k = 0; k < nc; ++k) {
+      std::vector<double>& tmp = scratch_[size_t(omp_get_thread_num())];
+      std::vector<double>& c = *columns[size_t(k)];
+      tmp.resize(n_);
+      for (size_t i = 0; i < n_; ++i) tmp[i] = c[order[i]];
+      c.swap(tmp);
+    }
     permute_int(id, order);
     permute_int(material, order);
     permute_int(body, order);
@@ -137,7 +147,7 @@ class Particles {
   }
   size_t n_ = 0;
   std::vector<Field> fields_;
-  std::vector<double> scratch_;
+  std::vector<std::vector<double>> scratch_;  // per thread
 };
 
 }  // namespace loam

@@ -14,6 +14,7 @@ void Partition<D>::sort(Particles<D>& p, const Grid<D>& g, int num_materials, in
   keys_.resize(n);
   std::array<const double*, D> x{};
   for (int d = 0; d < D; ++d) x[size_t(d)] = p.col(p.position, d);
+#pragma omp parallel for schedule(static) num_threads(threads)
   for (size_t i = 0; i < n; ++i) {
     size_t c = 0;
     for (int d = 0; d < D; ++d)
@@ -29,60 +30,53 @@ void Partition<D>::sort(Particles<D>& p, const Grid<D>& g, int num_materials, in
     std::vector<uint32_t> next(counts_.begin(), counts_.end() - 1);
     for (size_t i = 0; i < n; ++i) order_[next[keys_[i]]++] = uint32_t(i);
   }
-  p.permute(order_);
+  p.permute(order_, threads);
 
   material_ranges.assign(size_t(num_materials), {});
   for (int m = 0; m < num_materials; ++m)
     material_ranges[size_t(m)] = {counts_[size_t(m) * ncells], counts_[size_t(m + 1) * ncells]};
 
-  // Cut rows of the slowest axis into slabs of about equal particle count.
-  const int rows = g.cells[D - 1];
-  const size_t row_cells = ncells / size_t(rows);
-  auto row_start = [&](int m, int row) {
-    return size_t(counts_[size_t(m) * ncells + size_t(row) * row_cells]);
+  // Cut the cell order into slabs of equal particle count (cuts may fall inside a row), as many
+  // as keep same-colour slabs apart: 2 per colour per thread, fewer if the slabs get too thin.
+  // Balanced slabs matter: a colour phase lasts as long as its busiest thread.
+  const size_t row_cells = ncells / size_t(g.cells[D - 1]);
+  std::vector<size_t> before(ncells + 1, 0);  // particles in cells < c, over all materials
+  for (size_t c = 0; c <= ncells; ++c)
+    for (int m = 0; m < num_materials; ++m)
+      before[c] += counts_[size_t(m) * ncells + c] - counts_[size_t(m) * ncells];
+  auto build = [&](int num_slabs) {
+    slabs.clear();
+    size_t c0 = 0;
+    for (int k = 1; k <= num_slabs; ++k) {
+      size_t target = n * size_t(k) / size_t(num_slabs);
+      size_t c1 = k == num_slabs ? ncells
+                                 : size_t(std::lower_bound(before.begin() + long(c0), before.end(), target) -
+                                          before.begin());
+      c1 = std::min(c1, ncells);
+      Slab slab;
+      slab.row_begin = int(c0 / row_cells);
+      slab.row_end = int((c1 + row_cells - 1) / row_cells);
+      for (int m = 0; m < num_materials; ++m) {
+        IndexRange r{counts_[size_t(m) * ncells + c0], counts_[size_t(m) * ncells + c1]};
+        if (r.end > r.begin) slab.ranges.push_back(r);
+      }
+      slabs.push_back(std::move(slab));
+      c0 = c1;
+    }
   };
-  std::vector<size_t> row_count(size_t(rows), 0);
-  for (int m = 0; m < num_materials; ++m)
-    for (int r = 0; r < rows; ++r) row_count[size_t(r)] += row_start(m, r + 1) - row_start(m, r);
-
-  // Minimum slab width: the separating slab must cover the stencil reach, plus one row each
-  // side so that particles may drift a cell before the colouring needs a re-sort.
-  const int min_width = std::max(1, reach) + 2;
-  const int target_slabs = threads > 1 ? 8 * threads : 1;
-  const size_t target = std::max<size_t>(1, n / size_t(target_slabs));
-  std::vector<std::pair<int, int>> cuts;
-  int start = 0;
-  size_t count = 0;
-  for (int r = 0; r < rows; ++r) {
-    count += row_count[size_t(r)];
-    if (threads > 1 && count >= target && r + 1 - start >= min_width) {
-      cuts.push_back({start, r + 1});
-      start = r + 1;
-      count = 0;
-    }
+  // One spare row between same-colour slabs, so particles may drift before a re-sort is due.
+  constexpr int kMargin = 1;
+  int num_slabs = threads > 1 ? 8 * threads : 1;
+  for (; num_slabs >= 3; num_slabs -= 2) {
+    build(num_slabs);
+    if (separated(p, g, reach, kMargin)) return;
   }
-  if (start < rows) {
-    if (!cuts.empty() && rows - start < min_width) cuts.back().second = rows;
-    else cuts.push_back({start, rows});
-  }
-  slabs.clear();
-  for (auto [a, b] : cuts) {
-    Slab s;
-    s.row_begin = a;
-    s.row_end = b;
-    s.row_min = a;
-    s.row_max = b - 1;
-    for (int m = 0; m < num_materials; ++m) {
-      IndexRange r{row_start(m, a), row_start(m, b)};
-      if (r.end > r.begin) s.ranges.push_back(r);
-    }
-    slabs.push_back(std::move(s));
-  }
+  build(1);
 }
 
 template <int D>
-bool Partition<D>::verify(const Particles<D>& p, const Grid<D>& g, int rows_below,
-                          int rows_above) {
+bool Partition<D>::separated(const Particles<D>& p, const Grid<D>& g, int reach, int margin) {
+  // Measure each slab's row extent from its particles.
   const double* z = p.col(p.position, D - 1);
   const int n = int(slabs.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
@@ -99,17 +93,22 @@ bool Partition<D>::verify(const Particles<D>& p, const Grid<D>& g, int rows_belo
     slab.row_max = hi;
   }
   if (threads <= 1 || slabs.size() < 3) return true;
-  // Same-colour slabs must stay apart by more than the stencil reach.
+  // Same-colour slabs must be further apart than the stencil reach (plus the margin).
   for (int colour = 0; colour < 2; ++colour) {
     int last_max = -(1 << 29);
     for (int s = colour; s < n; s += 2) {
       const Slab& slab = slabs[size_t(s)];
       if (slab.row_max < 0) continue;  // empty
-      if (slab.row_min - rows_below <= last_max + rows_above) return false;
+      if (slab.row_min - last_max <= reach + margin) return false;
       last_max = std::max(last_max, slab.row_max);
     }
   }
   return true;
+}
+
+template <int D>
+bool Partition<D>::verify(const Particles<D>& p, const Grid<D>& g, int rows_below, int rows_above) {
+  return separated(p, g, rows_below + rows_above, 0);
 }
 
 template class Partition<1>;

@@ -3,10 +3,10 @@
 //
 // Particles are counting-sorted by (material, cell) every few steps: each material's particles
 // are one contiguous range (so a material update is a batch call), and inside it they are in
-// cell order (locality: neighbouring particles hit the same nodes). The cell rows along the
-// slowest grid axis are cut into slabs; a slab is the set of particles in its rows (one index
-// range per material). Slabs are coloured alternately: two slabs of one colour are separated by
-// a slab at least as wide as the stencil reach, so they never write the same node, and a
+// cell order (locality: neighbouring particles hit the same nodes). The cell order (the slowest
+// grid axis varies slowest) is cut into slabs of equal particle count; a slab is one index range
+// per material. Slabs are coloured alternately: two slabs of one colour are separated by more
+// rows than the stencil reaches, so they never write the same node, and a
 // particle-to-grid scatter runs race-free without atomics or locks: all colour-0 slabs in
 // parallel, then all colour-1 slabs (DESIGN.md "Hot loop"; measured 1.7-1.8x on 2 threads).
 //
@@ -33,7 +33,7 @@ class Partition {
  public:
   struct Slab {
     std::vector<IndexRange> ranges;  // one per material with particles in the slab
-    int row_begin = 0, row_end = 0;  // cell rows [row_begin, row_end) at sort time
+    int row_begin = 0, row_end = 0;  // cell rows overlapped at sort time
     int row_min = 0, row_max = -1;   // actual rows spanned now
   };
 
@@ -77,6 +77,8 @@ class Partition {
   }
 
  private:
+  /// Measure slab row extents; true if same-colour slabs are more than reach + margin rows apart.
+  bool separated(const Particles<D>& p, const Grid<D>& g, int reach, int margin);
   template <class F>
   static void run_slab(const Slab& s, F& f, int thread) {
     for (const auto& r : s.ranges)

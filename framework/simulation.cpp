@@ -311,43 +311,41 @@ int Simulation<D>::body_index(const std::string& name) const {
 
 template <int D>
 bool Simulation<D>::check_particles(std::string& what) const {
+  // Parallel scan for the first bad particle; the message is built only on failure.
   const size_t n = particles.size();
+  const int nf = 3;
+  const int fields[nf] = {particles.position, particles.velocity, particles.stress};
   size_t bad = n;
-  std::string field;
-  auto scan = [&](int f, const char* name) {
-    for (int c = 0; c < particles.info(f).components; ++c) {
-      const double* v = particles.col(f, c);
-      for (size_t i = 0; i < std::min(bad, n); ++i)
-        if (!std::isfinite(v[i])) {
-          bad = i;
-          field = std::string(name) + (particles.info(f).components > 1
-                                           ? "." + particles.info(f).component_names[size_t(c)]
-                                           : "");
-          break;
-        }
+#pragma omp parallel for reduction(min : bad) schedule(static) num_threads(threads)
+  for (size_t i = 0; i < n; ++i) {
+    bool ok = true;
+    for (int f = 0; f < nf; ++f)
+      for (int c = 0; c < particles.info(fields[f]).components; ++c)
+        ok = ok && std::isfinite(particles.col(fields[f], c)[i]);
+    for (int d = 0; d < D; ++d) {
+      const double x = particles.col(particles.position, d)[i];
+      ok = ok && x >= grid.origin[size_t(d)] && x <= grid.upper(d);
     }
-  };
-  scan(particles.position, "position");
-  scan(particles.velocity, "velocity");
-  scan(particles.stress, "stress");
-  if (bad == n) {
-    for (size_t i = 0; i < n && bad == n; ++i)
-      for (int d = 0; d < D; ++d) {
-        double x = particles.col(particles.position, d)[i];
-        if (x < grid.origin[size_t(d)] || x > grid.upper(d)) {
-          bad = i;
-          field = std::string("position.") + "xyz"[d] + " = " + format_number(x) +
-                  " (left the grid [" + format_number(grid.origin[size_t(d)]) + ", " +
-                  format_number(grid.upper(d)) + "])";
-          break;
-        }
-      }
+    if (!ok) bad = std::min(bad, i);
   }
   if (bad == n) return true;
+  std::string field;
+  for (int f = 0; f < nf && field.empty(); ++f)
+    for (int c = 0; c < particles.info(fields[f]).components && field.empty(); ++c)
+      if (!std::isfinite(particles.col(fields[f], c)[bad])) {
+        const FieldInfo& info = particles.info(fields[f]);
+        field = info.name + (info.components > 1 ? "." + info.component_names[size_t(c)] : "") +
+                " is not finite";
+      }
+  for (int d = 0; d < D && field.empty(); ++d) {
+    const double x = particles.col(particles.position, d)[bad];
+    if (x < grid.origin[size_t(d)] || x > grid.upper(d))
+      field = std::string("position.") + "xyz"[d] + " = " + format_number(x) + " (left the grid [" +
+              format_number(grid.origin[size_t(d)]) + ", " + format_number(grid.upper(d)) + "])";
+  }
   std::ostringstream s;
   s << "particle " << particles.id[bad] << " (body '" << bodies[particles.body[bad]].name
     << "'): " << field;
-  if (field.find("left") == std::string::npos) s << " is not finite";
   what = s.str();
   return false;
 }

@@ -36,6 +36,7 @@ class LinearElastic : public Material<D> {
     double rho_max = 0;
     const double* m = P.col(P.mass);
     const double* V = P.col(P.volume);
+#pragma omp parallel for reduction(max : rho_max) schedule(static)
     for (size_t i = b; i < e; ++i) rho_max = std::max(rho_max, m[i] / V[i]);
     return std::sqrt(M_ / std::max(rho_max, 1e-300));
   }
@@ -43,21 +44,10 @@ class LinearElastic : public Material<D> {
   void update_stress(const MaterialBatch<D>& batch) override {
     constexpr int NS = Particles<D>::NS;
     Particles<D>& P = *batch.particles;
-    std::array<double*, NS> s{};
-    for (int c = 0; c < NS; ++c) s[size_t(c)] = P.col(P.stress, c) + batch.begin;
-    for (int p = 0; p < batch.count; ++p) {
-      double d[3][3], w[3][3], sv[NS], sm[3][3], rot[3][3];
-      strain_and_spin<D>(batch.L, kBlock, size_t(p), batch.dt, d, w);
-      for (int c = 0; c < NS; ++c) sv[c] = s[size_t(c)][p];
-      voigt_to_matrix<NS>(sv, sm);
-      jaumann_rotation(w, sm, rot);
-      const double tr = d[0][0] + d[1][1] + d[2][2];
-      for (int c = 0; c < NS; ++c) {
-        static constexpr int I[6] = {0, 1, 2, 0, 1, 0}, J[6] = {0, 1, 2, 1, 2, 2};
-        const int i = I[c], j = J[c];
-        s[size_t(c)][p] = sv[c] + rot[i][j] + 2 * G_ * d[i][j] + (i == j ? lambda_ * tr : 0.0);
-      }
-    }
+    double* s[NS];
+    for (int c = 0; c < NS; ++c) s[c] = P.col(P.stress, c) + batch.begin;
+    for (int p = 0; p < batch.count; ++p)
+      jaumann_elastic_update<D>(s, batch.L, kBlock, size_t(p), batch.dt, lambda_, 2 * G_);
   }
 
   double strain_energy(const Particles<D>& P, size_t b, size_t e) const override {

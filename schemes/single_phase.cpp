@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
@@ -35,10 +36,16 @@ class SinglePhase : public Scheme<D> {
   void setup(Simulation<D>& sim, Diagnostics&) override {
     node_.assign(sim.grid.num_nodes * S, 0.0);
     vel_.assign(sim.grid.num_nodes * D, 0.0);
+    // Each thread allocates (and first touches) its own scratch, so buffers that are rewritten
+    // every block never share a cache line or page with another thread's.
     scratch_.resize(size_t(sim.threads));
-    for (auto& s : scratch_) {
-      s.stencil.allocate(sim.shape->nodes_per_particle());
-      s.L.assign(size_t(D * D * kBlock), 0.0);
+    const int npp = sim.shape->nodes_per_particle();
+#pragma omp parallel num_threads(sim.threads)
+    {
+      auto s = std::make_unique<Scratch>();
+      s->stencil.allocate(npp);
+      s->L.assign(size_t(D * D * kBlock), 0.0);
+      scratch_[size_t(omp_get_thread_num())] = std::move(s);
     }
   }
 
@@ -65,13 +72,12 @@ class SinglePhase : public Scheme<D> {
   double flip_;
   std::vector<double> node_;  // num_nodes * S
   std::vector<double> vel_;   // num_nodes * D: velocity used for the velocity gradient
-  struct Scratch {
+  struct alignas(64) Scratch {
     StencilBlock<D> stencil;
     std::vector<double> L;
     double max_v2 = 0;
-    char pad[64];  // keep threads' hot fields on separate cache lines
   };
-  std::vector<Scratch> scratch_;
+  std::vector<std::unique_ptr<Scratch>> scratch_;
 
   NodalVector node_vector(int offset) { return NodalVector{node_.data(), S, offset}; }
   NodalVector vel_vector() { return NodalVector{vel_.data(), D, 0}; }
@@ -86,7 +92,7 @@ class SinglePhase : public Scheme<D> {
   template <int NPP, bool MOMENTUM, bool FORCE>
   void scatter(Simulation<D>& sim, size_t b, int count, int thread) {
     Particles<D>& P = sim.particles;
-    StencilBlock<D>& st = scratch_[size_t(thread)].stencil;
+    StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
     sim.shape->evaluate(sim.grid, P, b, count, st);
     const int npp = NPP ? NPP : st.npp;
     const double* m = P.col(P.mass) + b;
@@ -172,7 +178,7 @@ class SinglePhase : public Scheme<D> {
   template <int NPP, bool REMAP, bool MOVE>
   void update_velocity(Simulation<D>& sim, double dt, size_t b, int count, int thread) {
     Particles<D>& P = sim.particles;
-    Scratch& sc = scratch_[size_t(thread)];
+    Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
     sim.shape->evaluate(sim.grid, P, b, count, st);
     const int npp = NPP ? NPP : st.npp;
@@ -221,7 +227,7 @@ class SinglePhase : public Scheme<D> {
   template <int NPP, bool MOVE>
   void update_stress(Simulation<D>& sim, double dt, size_t b, int count, int thread) {
     Particles<D>& P = sim.particles;
-    Scratch& sc = scratch_[size_t(thread)];
+    Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
     sim.shape->evaluate(sim.grid, P, b, count, st);
     const int npp = NPP ? NPP : st.npp;
@@ -277,11 +283,11 @@ class SinglePhase : public Scheme<D> {
   }
 
   void reset_max_speed() {
-    for (auto& s : scratch_) s.max_v2 = 0;
+    for (auto& s : scratch_) s->max_v2 = 0;
   }
   void store_max_speed(Simulation<D>& sim) {
     double m = 0;
-    for (auto& s : scratch_) m = std::max(m, s.max_v2);
+    for (auto& s : scratch_) m = std::max(m, s->max_v2);
     sim.max_speed = std::sqrt(m);
   }
 
