@@ -222,10 +222,19 @@ class SinglePhase : public Scheme<D> {
     sc.max_v2 = max_v2;
   }
 
-  /// Velocity gradient from vel_, volume update, optional move with the node_ velocity, and the
-  /// material's stress update for the block.
-  template <int NPP, bool MOVE>
+  /// What the gradient pass does besides the velocity gradient, volume and stress update.
+  enum class Gradient {
+    kRemapped,  // MUSL: L from the re-mapped velocity vel_; move with the updated grid velocity
+    kCurrent,   // USF: L from vel_ (velocity at t^n); particles do not move here
+    kUpdated,   // USL: L, move and FLIP update all from the updated grid record, in one pass
+  };
+
+  /// Velocity gradient, volume update, optional move / velocity update, and the material's
+  /// stress update for one block.
+  template <int NPP, Gradient MODE>
   void update_stress(Simulation<D>& sim, double dt, size_t b, int count, int thread) {
+    constexpr bool kMove = MODE != Gradient::kCurrent;
+    constexpr bool kFromRecord = MODE == Gradient::kUpdated;
     Particles<D>& P = sim.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
@@ -233,31 +242,51 @@ class SinglePhase : public Scheme<D> {
     const int npp = NPP ? NPP : st.npp;
     double* L = sc.L.data();
     double* V = P.col(P.volume) + b;
-    std::array<double*, D> x{};
-    for (int d = 0; d < D; ++d) x[size_t(d)] = P.col(P.position, d) + b;
+    std::array<double*, D> x{}, v{};
+    for (int d = 0; d < D; ++d) {
+      x[size_t(d)] = P.col(P.position, d) + b;
+      v[size_t(d)] = P.col(P.velocity, d) + b;
+    }
     const double* g = node_.data();
+    // Source of the velocity field whose gradient is taken.
+    const double* vel = kFromRecord ? node_.data() + 1 : vel_.data();
+    const size_t vstride = kFromRecord ? S : D;
+    const double flip = flip_;
+    double max_v2 = sc.max_v2;
     for (int p = 0; p < count; ++p) {
-      double l[D][D] = {}, vn[D] = {};
+      double l[D][D] = {}, vn[D] = {}, a[D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const size_t n = size_t(st.node[kp]);
-        const double* vv = vel_.data() + n * D;
+        const double* vv = vel + n * vstride;
         for (int j = 0; j < D; ++j) {
           const double gj = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
           for (int i = 0; i < D; ++i) l[i][j] += vv[i] * gj;
         }
-        if constexpr (MOVE) {
+        if constexpr (kMove) {
           const double w = st.w[kp];
           for (int d = 0; d < D; ++d) vn[d] += w * g[n * S + 1 + size_t(d)];
+          if constexpr (kFromRecord)
+            for (int d = 0; d < D; ++d) a[d] += w * g[n * S + 1 + D + size_t(d)];
         }
       }
       for (int i = 0; i < D; ++i)
         for (int j = 0; j < D; ++j) L[size_t(i * D + j) * kBlock + size_t(p)] = l[i][j];
       // V^{n+1} = det(I + L dt) V^n
       V[p] *= det_increment(l, dt);
-      if constexpr (MOVE)
+      if constexpr (kMove)
         for (int d = 0; d < D; ++d) x[size_t(d)][p] += dt * vn[d];
+      if constexpr (kFromRecord) {
+        double v2 = 0;
+        for (int d = 0; d < D; ++d) {
+          double& vp = v[size_t(d)][p];
+          vp = flip * (vp + dt * a[d]) + (1.0 - flip) * vn[d];
+          v2 += vp * vp;
+        }
+        max_v2 = std::max(max_v2, v2);
+      }
     }
+    sc.max_v2 = max_v2;
     MaterialBatch<D> batch;
     batch.begin = b;
     batch.count = count;
@@ -309,27 +338,17 @@ class SinglePhase : public Scheme<D> {
       });
       sim.timed("grid", [&] { momentum_to_velocity(sim, vel_.data(), D, 0); });
       sim.timed("g2p_gradient_stress", [&] {
-        sim.gather_blocks([&](size_t b, int c, int t) { update_stress<NPP, true>(sim, dt, b, c, t); });
+        sim.gather_blocks([&](size_t b, int c, int t) { update_stress<NPP, Gradient::kRemapped>(sim, dt, b, c, t); });
       });
     } else {
-      // USL: the velocity gradient comes from the updated grid velocity itself.
-      sim.timed("grid", [&] { copy_updated_velocity(sim); });
+      // USL: gradient, move and velocity update from the updated grid record in one pass.
       sim.timed("g2p_gradient_stress", [&] {
-        sim.gather_blocks([&](size_t b, int c, int t) { update_stress<NPP, false>(sim, dt, b, c, t); });
-      });
-      sim.timed("g2p_velocity", [&] {
-        sim.gather_blocks(
-            [&](size_t b, int c, int t) { update_velocity<NPP, false, true>(sim, dt, b, c, t); });
+        sim.gather_blocks([&](size_t b, int c, int t) {
+          update_stress<NPP, Gradient::kUpdated>(sim, dt, b, c, t);
+        });
       });
     }
     store_max_speed(sim);
-  }
-
-  void copy_updated_velocity(Simulation<D>& sim) {
-    const long n = long(sim.grid.num_nodes);
-#pragma omp parallel for schedule(static) num_threads(sim.threads)
-    for (long i = 0; i < n; ++i)
-      for (int d = 0; d < D; ++d) vel_[size_t(i) * D + size_t(d)] = node_[size_t(i) * S + 1 + size_t(d)];
   }
 
   template <int NPP>
@@ -338,7 +357,7 @@ class SinglePhase : public Scheme<D> {
     zero(node_, sim.threads);
     sim.scatter_blocks([&](size_t b, int c, int t) { scatter<NPP, true, false>(sim, b, c, t); });
     momentum_to_velocity(sim, node_.data(), S, 1);
-    sim.gather_blocks([&](size_t b, int c, int t) { update_stress<NPP, false>(sim, dt, b, c, t); });
+    sim.gather_blocks([&](size_t b, int c, int t) { update_stress<NPP, Gradient::kCurrent>(sim, dt, b, c, t); });
     sim.scatter_blocks([&](size_t b, int c, int t) { scatter<NPP, false, true>(sim, b, c, t); });
     integrate(sim, dt);
     reset_max_speed();
