@@ -1,6 +1,7 @@
-// Throughput benchmark (not part of the core: its scenes name concrete plugins): an elastic block under gravity on a fixed base, ~100k particles, a fixed
-// number of steps after a short warm-up, reported as particle-steps per second (DESIGN.md: speed
-// lives in benchmarks, never in timed unit tests).
+// Throughput benchmark (not part of the core: its scenes name concrete plugins): an elastic block
+// under gravity on a fixed base, ~100k particles, a fixed number of steps after a short warm-up,
+// reported as particle-steps per second (DESIGN.md: speed lives in benchmarks, never in timed unit
+// tests).
 #include "bench.hpp"
 
 #include <algorithm>
@@ -12,10 +13,12 @@
 
 namespace loam {
 
-std::string bench_scene(const std::string& scene, const std::string& shape, const std::string& update) {
+std::string bench_scene(const std::string& scene, const std::string& shape,
+                        const std::string& update) {
   // 2D: 160 x 160 cells of block, 2 x 2 particles per cell = 102 400 particles.
   // 3D: 24 x 24 x 22 cells of block, 2 x 2 x 2 particles per cell = 101 376 particles.
-  std::string common = "shape_function: " + shape + "\nscheme: {type: single_phase, update: " + update +
+  std::string common = "shape_function: " + shape +
+                       "\nscheme: {type: single_phase, update: " + update +
                        "}\ntime: {end: 1.0e3, cfl: 0.5}\n";
   if (scene == "elastic_block_2d")
     return common + R"(grid: {origin: [0, 0], extent: [1.0, 1.1], cell_size: 0.00625}
@@ -31,7 +34,8 @@ boundaries:
   - {type: slip, face: x+}
 )";
   if (scene == "elastic_block_3d")
-    return common + R"(grid: {origin: [0, 0, 0], extent: [1.0, 1.0, 1.0], cell_size: 0.0416666666666667}
+    return common +
+           R"(grid: {origin: [0, 0, 0], extent: [1.0, 1.0, 1.0], cell_size: 0.0416666666666667}
 gravity: [0, 0, -9.81]
 bodies:
   - name: block
@@ -53,7 +57,8 @@ int run_bench(const BenchOptions& opt) {
   for (const auto& scene : opt.scenes) {
     std::string yaml = bench_scene(scene, opt.shape, opt.update);
     if (yaml.empty()) {
-      std::fprintf(stderr, "loam: error: unknown bench scene '%s' (elastic_block_2d, elastic_block_3d)\n",
+      std::fprintf(stderr,
+                   "loam: error: unknown bench scene '%s' (elastic_block_2d, elastic_block_3d)\n",
                    scene.c_str());
       return 2;
     }
@@ -109,12 +114,15 @@ int run_bench(const BenchOptions& opt) {
       if (opt.json) {
         std::printf("%s\n", j.dump().c_str());
       } else {
-        std::printf("%-18s %dD %-8s %-5s %zu particles, %ld steps, %d thread(s): %7.2f M particle-steps/s, %zu B/particle\n",
-                    scene.c_str(), s["dimension"].get<int>(), opt.shape.c_str(), opt.update.c_str(),
-                    s["particles"].get<size_t>(), s["steps"].get<long>(), threads,
-                    s["particle_steps_per_second"].get<double>() / 1e6,
-                    s["bytes_per_particle"].get<size_t>());
-        if (j.contains("profile_fraction")) std::printf("    profile: %s\n", j["profile_fraction"].dump().c_str());
+        std::printf(
+            "%-18s %dD %-8s %-5s %zu particles, %ld steps, %d thread(s): %7.2f M particle-steps/s, "
+            "%zu B/particle\n",
+            scene.c_str(), s["dimension"].get<int>(), opt.shape.c_str(), opt.update.c_str(),
+            s["particles"].get<size_t>(), s["steps"].get<long>(), threads,
+            s["particle_steps_per_second"].get<double>() / 1e6,
+            s["bytes_per_particle"].get<size_t>());
+        if (j.contains("profile_fraction"))
+          std::printf("    profile: %s\n", j["profile_fraction"].dump().c_str());
       }
       std::fflush(stdout);
     }

@@ -19,6 +19,7 @@ struct BenchOptions {
 int run_bench(const BenchOptions& options);
 
 /// The YAML of a benchmark scene (also used by tests to check the scenes are valid).
-std::string bench_scene(const std::string& scene, const std::string& shape, const std::string& update);
+std::string bench_scene(const std::string& scene, const std::string& shape,
+                        const std::string& update);
 
 }  // namespace loam

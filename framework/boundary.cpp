@@ -21,7 +21,8 @@ bool check_face(const Face& f, int dim, const Params& p, const std::string& key,
   if (f.axis < dim) return true;
   d.error(p.where(key), p.path(key),
           "face '" + p.text(key) + "' does not exist in " + std::to_string(dim) + "D (faces: " +
-              join(std::vector<std::string>(face_names().begin(), face_names().begin() + 2 * dim), ", ") +
+              join(std::vector<std::string>(face_names().begin(), face_names().begin() + 2 * dim),
+                   ", ") +
               ")");
   return false;
 }

@@ -18,10 +18,12 @@ Schema config_schema() {
   {
     Schema g;
     g.vector("origin", "m", "lower corner of the grid").def("0").scalar_ok();
-    g.vector("extent", "m", "size of the grid along each axis; its length sets the dimension (1, 2 or 3)")
+    g.vector("extent", "m",
+             "size of the grid along each axis; its length sets the dimension (1, 2 or 3)")
         .required()
         .positive();
-    g.vector("cell_size", "m", "cell size (one number or one per axis); the extent must be a multiple")
+    g.vector("cell_size", "m",
+             "cell size (one number or one per axis); the extent must be a multiple")
         .required()
         .positive()
         .scalar_ok();
@@ -68,10 +70,13 @@ Schema config_schema() {
     Schema o;
     o.integer("every_steps", "write a frame every N steps").min(1);
     o.real("every_time", "s", "write a frame every T seconds of simulated time").positive();
-    o.string_list("fields", "particle fields to write besides position (see `loam fields`)")
+    o.string_list(
+         "fields",
+         "particle fields to write besides position (an unknown name lists the available ones)")
         .def("[velocity, stress]");
     o.plugin("writer", "writer", "output format").def(reg.default_of("writer"));
-    o.integer("history_every", "write energies and momentum to history.csv every N steps (0: at frames)")
+    o.integer("history_every",
+              "write energies and momentum to history.csv every N steps (0: at frames)")
         .def("0")
         .min(0);
     s.section("output", o, "output of particle frames");
@@ -106,8 +111,10 @@ namespace {
 
 /// yaml-cpp's parser message, with a hint where its wording is parser jargon.
 std::string yaml_message(const YAML::Exception& e) {
-  if (e.msg == YAML::ErrorMsg::END_OF_SEQ_FLOW) return e.msg + " (a '[' is not closed or a ',' is missing)";
-  if (e.msg == YAML::ErrorMsg::END_OF_MAP_FLOW) return e.msg + " (a '{' is not closed or a ',' is missing)";
+  if (e.msg == YAML::ErrorMsg::END_OF_SEQ_FLOW)
+    return e.msg + " (a '[' is not closed or a ',' is missing)";
+  if (e.msg == YAML::ErrorMsg::END_OF_MAP_FLOW)
+    return e.msg + " (a '{' is not closed or a ',' is missing)";
   return e.msg;
 }
 
@@ -141,8 +148,8 @@ bool apply_override(YAML::Node root, const std::string& arg, const std::string& 
     if (cur.IsSequence()) {
       if (!is_index || std::stoul(k) >= cur.size()) {
         diag.error(Location{label, 1, 1}, path,
-                   "'" + k + "' is not an index of the list (it has " +
-                       std::to_string(cur.size()) + " entries)");
+                   "'" + k + "' is not an index of the list (it has " + std::to_string(cur.size()) +
+                       " entries)");
         return false;
       }
       chain.push_back(cur[std::stoul(k)]);
@@ -167,8 +174,8 @@ bool apply_override(YAML::Node root, const std::string& arg, const std::string& 
 }
 
 int detect_dimension(const YAML::Node& root) {
-  YAML::Node e = root.IsMap() && root["grid"] && root["grid"].IsMap() ? root["grid"]["extent"]
-                                                                         : YAML::Node();
+  YAML::Node e =
+      root.IsMap() && root["grid"] && root["grid"].IsMap() ? root["grid"]["extent"] : YAML::Node();
   if (e && e.IsSequence() && e.size() >= 1 && e.size() <= 3) return int(e.size());
   return 0;
 }
@@ -211,9 +218,9 @@ LoadedConfig validate_tree(YAML::Node root, const std::string& file,
   if (!out.dimension && root["grid"] && root["grid"].IsMap() && root["grid"]["extent"] &&
       root["grid"]["extent"].IsSequence()) {
     YAML::Node e = root["grid"]["extent"];
-    diag.error(location_of(e, "grid.extent", ctx, Location{file, 1, 1}), "grid.extent",
-               "the grid needs 1, 2 or 3 components (one per dimension), got " +
-                   std::to_string(e.size()));
+    diag.error(
+        location_of(e, "grid.extent", ctx, Location{file, 1, 1}), "grid.extent",
+        "the grid needs 1, 2 or 3 components (one per dimension), got " + std::to_string(e.size()));
   }
   Schema schema = config_schema();
   // Stress fields have 3 + D(D-1)/2 components (Voigt, with the out-of-plane normal stress).
@@ -249,10 +256,10 @@ LoadedConfig load_config(const std::string& file, const std::vector<std::string>
                          Diagnostics& diag) {
   std::ifstream in(file);
   if (!in) {
-    diag.error(Location{file, 1, 1}, "", "cannot open the run file: " +
-                                             std::string(std::filesystem::exists(file)
-                                                             ? "permission denied"
-                                                             : "no such file"));
+    diag.error(
+        Location{file, 1, 1}, "",
+        "cannot open the run file: " +
+            std::string(std::filesystem::exists(file) ? "permission denied" : "no such file"));
     LoadedConfig out;
     out.file = file;
     return out;

@@ -8,7 +8,7 @@ template <int D>
 class Simulation;
 
 struct NodeForces {
-  const double* mass;     // mass[n*stride]
+  const double* mass;  // mass[n*stride]
   NodalVector momentum;
   NodalVector force;
   size_t num_nodes;

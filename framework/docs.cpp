@@ -45,8 +45,10 @@ void print_schema(std::ostringstream& o, const Schema& s, bool md, const std::st
 
 void print_kind(std::ostringstream& o, const KindInfo& k, bool md) {
   const Registry& reg = Registry::instance();
-  if (md) o << "## " << k.name << "\n\n" << k.doc << "\n\n";
-  else o << k.name << " — " << k.doc << "\n";
+  if (md)
+    o << "## " << k.name << "\n\n" << k.doc << "\n\n";
+  else
+    o << k.name << " — " << k.doc << "\n";
   for (const auto& name : reg.names(k.name)) {
     const PluginInfo* info = reg.find(k.name, name);
     if (md) {
@@ -70,7 +72,8 @@ bool print_plugins(const std::string& kind, bool markdown, std::string& out) {
   if (!kind.empty() && !reg.has_kind(kind)) {
     std::vector<std::string> names;
     for (const auto& k : reg.kinds()) names.push_back(k.name);
-    out = "loam: error: unknown plugin kind '" + kind + "'" + suggest(kind, names, "kinds are") + "\n";
+    out = "loam: error: unknown plugin kind '" + kind + "'" + suggest(kind, names, "kinds are") +
+          "\n";
     return false;
   }
   if (markdown && kind.empty())

@@ -21,15 +21,18 @@ int main(int argc, char** argv) {
   run->add_option("--set", run_opt.overrides, "override a key: path.to.key=value (repeatable)")
       ->allow_extra_args(false);
   run->add_option("--out", run_opt.out_dir, "output directory (default results/<config name>)");
-  run->add_flag("--overwrite", run_opt.overwrite, "replace the results in a non-empty output directory");
-  run->add_option("--threads", run_opt.threads, "OpenMP threads (default: all cores)")->check(CLI::Range(1, 1024));
+  run->add_flag("--overwrite", run_opt.overwrite,
+                "replace the results in a non-empty output directory");
+  run->add_option("--threads", run_opt.threads, "OpenMP threads (default: all cores)")
+      ->check(CLI::Range(1, 1024));
   run->add_flag("--quiet", run_opt.quiet, "no progress lines");
 
   std::string check_file;
   std::vector<std::string> check_sets;
   auto* check = app.add_subcommand("check", "validate a run file without running it");
   check->add_option("config", check_file, "run file (YAML)")->required();
-  check->add_option("--set", check_sets, "override a key: path.to.key=value")->allow_extra_args(false);
+  check->add_option("--set", check_sets, "override a key: path.to.key=value")
+      ->allow_extra_args(false);
 
   std::string kind;
   bool markdown = false;
@@ -44,12 +47,15 @@ int main(int argc, char** argv) {
   loam::BenchOptions bench_opt;
   auto* bench = app.add_subcommand("bench", "throughput benchmark on fixed scenes");
   bench->add_flag("--json", bench_opt.json, "one JSON object per run, nothing else");
-  bench->add_option("--steps", bench_opt.steps, "timed steps per run")->check(CLI::Range(1, 1000000));
+  bench->add_option("--steps", bench_opt.steps, "timed steps per run")
+      ->check(CLI::Range(1, 1000000));
   bench->add_option("--threads", bench_opt.threads, "thread counts to run (default 1 2)");
-  bench->add_option("--scenes", bench_opt.scenes, "scenes (default: elastic_block_2d elastic_block_3d)");
+  bench->add_option("--scenes", bench_opt.scenes,
+                    "scenes (default: elastic_block_2d elastic_block_3d)");
   bench->add_option("--update", bench_opt.update, "musl, usl or usf");
   bench->add_option("--shape-function", bench_opt.shape, "shape function");
-  bench->add_option("--repeat", bench_opt.repeat, "repeat each run and report the median")->check(CLI::Range(1, 20));
+  bench->add_option("--repeat", bench_opt.repeat, "repeat each run and report the median")
+      ->check(CLI::Range(1, 20));
   bench->add_flag("--profile", bench_opt.profile, "print where the step's time goes");
 
   try {

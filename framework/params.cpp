@@ -20,7 +20,9 @@ std::string format_number(double v) {
   return s.str();
 }
 
-bool ParamSpec::has_range() const { return std::isfinite(lo) || std::isfinite(hi); }
+bool ParamSpec::has_range() const {
+  return std::isfinite(lo) || std::isfinite(hi);
+}
 
 std::string ParamSpec::range_text() const {
   return std::string(lo_open || !std::isfinite(lo) ? "(" : "[") + format_number(lo) + ", " +
@@ -35,20 +37,32 @@ static std::string length_text(int length) {
 
 std::string ParamSpec::type_text() const {
   switch (type) {
-    case ParamType::Real: return "real";
-    case ParamType::Integer: return "integer";
-    case ParamType::Boolean: return "bool";
-    case ParamType::String: return "string";
-    case ParamType::Choice: return "one of {" + join(choices, ", ") + "}";
+    case ParamType::Real:
+      return "real";
+    case ParamType::Integer:
+      return "integer";
+    case ParamType::Boolean:
+      return "bool";
+    case ParamType::String:
+      return "string";
+    case ParamType::Choice:
+      return "one of {" + join(choices, ", ") + "}";
     case ParamType::Vector:
       return "vector[" + length_text(length) + "]" + (broadcast_scalar ? " or real" : "");
-    case ParamType::RealList: return "list of reals";
-    case ParamType::VectorList: return "list of vector[" + length_text(length) + "]";
-    case ParamType::StringList: return "list of strings";
-    case ParamType::Section: return "map";
-    case ParamType::SectionList: return "list of maps";
-    case ParamType::Plugin: return plugin_kind + " {type: ...}";
-    case ParamType::PluginList: return "list of " + plugin_kind + " {type: ...}";
+    case ParamType::RealList:
+      return "list of reals";
+    case ParamType::VectorList:
+      return "list of vector[" + length_text(length) + "]";
+    case ParamType::StringList:
+      return "list of strings";
+    case ParamType::Section:
+      return "map";
+    case ParamType::SectionList:
+      return "list of maps";
+    case ParamType::Plugin:
+      return plugin_kind + " {type: ...}";
+    case ParamType::PluginList:
+      return "list of " + plugin_kind + " {type: ...}";
   }
   return "?";
 }
@@ -149,8 +163,12 @@ double Params::real(const std::string& k) const {
   if (auto* i = std::get_if<long long>(&e.value)) return double(*i);
   return get_as<double>(e, path(k));
 }
-long long Params::integer(const std::string& k) const { return get_as<long long>(at(k), path(k)); }
-bool Params::flag(const std::string& k) const { return get_as<bool>(at(k), path(k)); }
+long long Params::integer(const std::string& k) const {
+  return get_as<long long>(at(k), path(k));
+}
+bool Params::flag(const std::string& k) const {
+  return get_as<bool>(at(k), path(k));
+}
 const std::string& Params::text(const std::string& k) const {
   return get_as<std::string>(at(k), path(k));
 }
@@ -254,7 +272,8 @@ struct Validator {
   }
 
   bool in_range(const ParamSpec& spec, double v, const std::string& path, const Location& loc) {
-    bool ok = (spec.lo_open ? v > spec.lo : v >= spec.lo) && (spec.hi_open ? v < spec.hi : v <= spec.hi);
+    bool ok =
+        (spec.lo_open ? v > spec.lo : v >= spec.lo) && (spec.hi_open ? v < spec.hi : v <= spec.hi);
     if (!ok)
       diag.error(loc, path,
                  format_number(v) + " is out of range " + spec.range_text() +
@@ -274,14 +293,17 @@ struct Validator {
     if (!n.IsSequence()) {
       diag.error(loc, path,
                  "expected a list of " + std::to_string(want) + " real numbers" +
-                     (spec.broadcast_scalar ? " or one real number" : "") + ", got " + node_text(n));
+                     (spec.broadcast_scalar ? " or one real number" : "") + ", got " +
+                     node_text(n));
       return false;
     }
     if (want > 0 && int(n.size()) != want) {
-      diag.error(loc, path,
-                 "expected " + std::to_string(want) + " components" +
-                     (spec.length == kDimension ? " (the grid is " + std::to_string(ctx.dimension) + "D)" : "") +
-                     ", got " + std::to_string(n.size()));
+      diag.error(
+          loc, path,
+          "expected " + std::to_string(want) + " components" +
+              (spec.length == kDimension ? " (the grid is " + std::to_string(ctx.dimension) + "D)"
+                                         : "") +
+              ", got " + std::to_string(n.size()));
       return false;
     }
     bool ok = true;
@@ -290,8 +312,10 @@ struct Validator {
       double v = 0;
       std::string p = path + "." + std::to_string(i);
       Location l = location_of(n[i], p, ctx, loc);
-      if (parse_real(n[i], p, l, v) && in_range(spec, v, p, l)) out.push_back(v);
-      else ok = false;
+      if (parse_real(n[i], p, l, v) && in_range(spec, v, p, l))
+        out.push_back(v);
+      else
+        ok = false;
     }
     return ok;
   }
@@ -332,7 +356,8 @@ struct Validator {
         return {};
       case ParamType::Choice: {
         if (!n.IsScalar()) {
-          diag.error(loc, path, "expected one of " + join(spec.choices, ", ") + ", got " + node_text(n));
+          diag.error(loc, path,
+                     "expected one of " + join(spec.choices, ", ") + ", got " + node_text(n));
           return {};
         }
         for (const auto& c : spec.choices)
@@ -360,8 +385,10 @@ struct Validator {
           double v;
           std::string p = path + "." + std::to_string(i);
           Location l = location_of(n[i], p, ctx, loc);
-          if (parse_real(n[i], p, l, v) && in_range(spec, v, p, l)) out.push_back(v);
-          else ok = false;
+          if (parse_real(n[i], p, l, v) && in_range(spec, v, p, l))
+            out.push_back(v);
+          else
+            ok = false;
         }
         if (ok) return out;
         return {};
@@ -376,8 +403,10 @@ struct Validator {
         for (size_t i = 0; i < n.size(); ++i) {
           std::vector<double> v;
           std::string p = path + "." + std::to_string(i);
-          if (parse_vector(spec, n[i], p, location_of(n[i], p, ctx, loc), v)) out.push_back(v);
-          else ok = false;
+          if (parse_vector(spec, n[i], p, location_of(n[i], p, ctx, loc), v))
+            out.push_back(v);
+          else
+            ok = false;
         }
         if (ok) return out;
         return {};
@@ -392,9 +421,11 @@ struct Validator {
         bool ok = true;
         for (size_t i = 0; i < n.size(); ++i) {
           std::string p = path + "." + std::to_string(i);
-          if (n[i].IsScalar()) out.push_back(n[i].Scalar());
+          if (n[i].IsScalar())
+            out.push_back(n[i].Scalar());
           else {
-            diag.error(location_of(n[i], p, ctx, loc), p, "expected a name, got " + node_text(n[i]));
+            diag.error(location_of(n[i], p, ctx, loc), p,
+                       "expected a name, got " + node_text(n[i]));
             ok = false;
           }
         }
@@ -435,9 +466,11 @@ struct Validator {
         if (n.IsMap() && !n["type"] && !spec.default_text.empty()) {
           YAML::Node copy = YAML::Clone(n);
           copy["type"] = spec.default_text;
-          return std::make_shared<Params>(plugin(copy, spec.plugin_kind, spec.plugin_components, path, loc));
+          return std::make_shared<Params>(
+              plugin(copy, spec.plugin_kind, spec.plugin_components, path, loc));
         }
-        return std::make_shared<Params>(plugin(n, spec.plugin_kind, spec.plugin_components, path, loc));
+        return std::make_shared<Params>(
+            plugin(n, spec.plugin_kind, spec.plugin_components, path, loc));
       }
     }
     return {};
@@ -479,13 +512,18 @@ struct Validator {
         out.set(spec.key, inner.value(spec, d, p, loc), loc, true);
         if (!quiet.ok()) throw std::logic_error("invalid default for " + p + ": " + quiet.format());
       } else if (spec.is_required) {
-        std::string what = spec.doc.empty() ? "" : " (" + spec.doc + (spec.unit.empty() || spec.unit == "-" ? "" : ", " + spec.unit) + ")";
+        std::string what =
+            spec.doc.empty()
+                ? ""
+                : " (" + spec.doc +
+                      (spec.unit.empty() || spec.unit == "-" ? "" : ", " + spec.unit) + ")";
         diag.error(loc, p, "missing required key '" + spec.key + "'" + what);
         all_valid = false;
       } else if (spec.type == ParamType::SectionList || spec.type == ParamType::PluginList) {
         out.set(spec.key, std::vector<Params>{}, loc, true);
       } else if (spec.type == ParamType::Section) {
-        out.set(spec.key, std::make_shared<Params>(section(YAML::Node(), *spec.section, p, loc)), loc, true);
+        out.set(spec.key, std::make_shared<Params>(section(YAML::Node(), *spec.section, p, loc)),
+                loc, true);
       }
     }
     if (all_valid)
@@ -514,14 +552,15 @@ struct Validator {
       YAML::Node t = n["type"];
       if (!t || !t.IsScalar()) {
         diag.error(loc, type_path,
-                   "missing required key 'type' (a " + kind + "; valid types are: " +
-                       join(reg.names(kind), ", ") + ")");
+                   "missing required key 'type' (a " + kind +
+                       "; valid types are: " + join(reg.names(kind), ", ") + ")");
         return failed;
       }
       name = t.Scalar();
       type_loc = location_of(t, type_path, ctx, loc);
     } else {
-      diag.error(loc, path, "expected a " + kind + " name or a map with 'type', got " + node_text(n));
+      diag.error(loc, path,
+                 "expected a " + kind + " name or a map with 'type', got " + node_text(n));
       return failed;
     }
     const PluginInfo* info = reg.find(kind, name);

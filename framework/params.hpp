@@ -21,14 +21,18 @@ class Node;
 namespace loam {
 
 enum class ParamType {
-  Real, Integer, Boolean, String, Choice,
+  Real,
+  Integer,
+  Boolean,
+  String,
+  Choice,
   Vector,      // fixed-length list of reals (length: dimension, components, or a number)
   RealList,    // any-length list of reals
   VectorList,  // list of vectors (e.g. polygon vertices)
   StringList,
-  Section,     // nested map with its own schema
+  Section,  // nested map with its own schema
   SectionList,
-  Plugin,      // map with `type:` naming a plugin of a kind; validated by that plugin's schema
+  Plugin,  // map with `type:` naming a plugin of a kind; validated by that plugin's schema
   PluginList
 };
 
@@ -55,17 +59,48 @@ struct ParamSpec {
   std::string plugin_kind;
   int plugin_components = kDimension;  // component count passed to a field plugin
 
-  ParamSpec& required() { is_required = true; return *this; }
-  ParamSpec& def(std::string yaml_text) { default_text = std::move(yaml_text); return *this; }
-  ParamSpec& min(double v) { lo = v; lo_open = false; return *this; }
-  ParamSpec& above(double v) { lo = v; lo_open = true; return *this; }
-  ParamSpec& max(double v) { hi = v; hi_open = false; return *this; }
-  ParamSpec& below(double v) { hi = v; hi_open = true; return *this; }
+  ParamSpec& required() {
+    is_required = true;
+    return *this;
+  }
+  ParamSpec& def(std::string yaml_text) {
+    default_text = std::move(yaml_text);
+    return *this;
+  }
+  ParamSpec& min(double v) {
+    lo = v;
+    lo_open = false;
+    return *this;
+  }
+  ParamSpec& above(double v) {
+    lo = v;
+    lo_open = true;
+    return *this;
+  }
+  ParamSpec& max(double v) {
+    hi = v;
+    hi_open = false;
+    return *this;
+  }
+  ParamSpec& below(double v) {
+    hi = v;
+    hi_open = true;
+    return *this;
+  }
   ParamSpec& positive() { return above(0.0); }
   ParamSpec& non_negative() { return min(0.0); }
-  ParamSpec& len(int n) { length = n; return *this; }
-  ParamSpec& scalar_ok() { broadcast_scalar = true; return *this; }
-  ParamSpec& components(int n) { plugin_components = n; return *this; }
+  ParamSpec& len(int n) {
+    length = n;
+    return *this;
+  }
+  ParamSpec& scalar_ok() {
+    broadcast_scalar = true;
+    return *this;
+  }
+  ParamSpec& components(int n) {
+    plugin_components = n;
+    return *this;
+  }
 
   bool has_range() const;
   std::string range_text() const;  // "(0, 0.5]" style
@@ -107,10 +142,10 @@ class Schema {
 /// Validated values of one map (a plugin's parameters or a config section).
 class Params {
  public:
-  using Value = std::variant<std::monostate, double, long long, bool, std::string,
-                             std::vector<double>, std::vector<std::vector<double>>,
-                             std::vector<std::string>, std::shared_ptr<Params>,
-                             std::vector<Params>>;
+  using Value =
+      std::variant<std::monostate, double, long long, bool, std::string, std::vector<double>,
+                   std::vector<std::vector<double>>, std::vector<std::string>,
+                   std::shared_ptr<Params>, std::vector<Params>>;
   struct Entry {
     Value value;
     Location where;

@@ -14,7 +14,9 @@ namespace loam {
 
 /// Stress components stored per dimension, Voigt order xx, yy, zz, xy, yz, xz.
 /// 1D keeps the lateral normal stresses (a confined column has sigma_h != 0), 2D is plane strain.
-constexpr int stress_components(int D) { return 3 + D * (D - 1) / 2; }
+constexpr int stress_components(int D) {
+  return 3 + D * (D - 1) / 2;
+}
 
 /// Voigt index of tensor component (i, j) for i, j < 3.
 constexpr int voigt_index(int i, int j) {

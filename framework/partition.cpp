@@ -49,9 +49,10 @@ void Partition<D>::sort(Particles<D>& p, const Grid<D>& g, int num_materials, in
     size_t c0 = 0;
     for (int k = 1; k <= num_slabs; ++k) {
       size_t target = n * size_t(k) / size_t(num_slabs);
-      size_t c1 = k == num_slabs ? ncells
-                                 : size_t(std::lower_bound(before.begin() + long(c0), before.end(), target) -
-                                          before.begin());
+      size_t c1 = k == num_slabs
+                      ? ncells
+                      : size_t(std::lower_bound(before.begin() + long(c0), before.end(), target) -
+                               before.begin());
       c1 = std::min(c1, ncells);
       Slab slab;
       slab.row_begin = int(c0 / row_cells);

@@ -28,7 +28,8 @@ constexpr int kPluginAbiVersion = 1;
 struct PluginInfo {
   std::string kind, name, summary;
   std::function<Schema()> schema;
-  std::array<std::any, 3> factories;  // [D-1]: std::function<std::unique_ptr<Base<D>>(const Params&)>
+  std::array<std::any, 3>
+      factories;  // [D-1]: std::function<std::unique_ptr<Base<D>>(const Params&)>
   std::string origin = "built-in";
 };
 
@@ -61,7 +62,9 @@ class Registry {
   void set_default(const std::string& kind, const std::string& name) { defaults_[kind] = name; }
   /// The plugin a bare YAML list stands for in this kind (fields: a constant value), or "".
   std::string list_shorthand(const std::string& kind) const;
-  void set_list_shorthand(const std::string& kind, const std::string& name) { shorthand_[kind] = name; }
+  void set_list_shorthand(const std::string& kind, const std::string& name) {
+    shorthand_[kind] = name;
+  }
 
   /// Label attached to plugins registered while loading a shared library.
   std::string loading_origin = "built-in";
@@ -99,24 +102,24 @@ std::string load_plugin_library(const std::string& path);
 
 #define LOAM_CONCAT_INNER(a, b) a##b
 #define LOAM_CONCAT(a, b) LOAM_CONCAT_INNER(a, b)
-#define LOAM_REGISTER(BASE, IMPL)                                               \
-  namespace {                                                                   \
-  [[maybe_unused]] const bool LOAM_CONCAT(loam_registered_, IMPL) =             \
-      ::loam::register_plugin<::loam::BASE, IMPL>();                            \
+#define LOAM_REGISTER(BASE, IMPL)                                                                \
+  namespace {                                                                                    \
+  [[maybe_unused]] const bool LOAM_CONCAT(loam_registered_,                                      \
+                                          IMPL) = ::loam::register_plugin<::loam::BASE, IMPL>(); \
   }
 /// Register a plugin and make it the one used when a config omits its key.
-#define LOAM_REGISTER_DEFAULT(BASE, IMPL)                                       \
-  namespace {                                                                   \
-  [[maybe_unused]] const bool LOAM_CONCAT(loam_registered_, IMPL) =             \
-      ::loam::register_plugin<::loam::BASE, IMPL>(true);                        \
+#define LOAM_REGISTER_DEFAULT(BASE, IMPL)                           \
+  namespace {                                                       \
+  [[maybe_unused]] const bool LOAM_CONCAT(loam_registered_, IMPL) = \
+      ::loam::register_plugin<::loam::BASE, IMPL>(true);            \
   }
-#define LOAM_REGISTER_KIND_SHORTHAND(KIND, NAME)                                   \
-  namespace {                                                                      \
-  [[maybe_unused]] const bool LOAM_CONCAT(loam_shorthand_, __LINE__) =             \
-      (::loam::Registry::instance().set_list_shorthand(KIND, NAME), true);         \
+#define LOAM_REGISTER_KIND_SHORTHAND(KIND, NAME)                           \
+  namespace {                                                              \
+  [[maybe_unused]] const bool LOAM_CONCAT(loam_shorthand_, __LINE__) =     \
+      (::loam::Registry::instance().set_list_shorthand(KIND, NAME), true); \
   }
-#define LOAM_REGISTER_KIND(KIND, DOC)                                              \
-  namespace {                                                                      \
-  [[maybe_unused]] const bool LOAM_CONCAT(loam_kind_, __LINE__) =                  \
-      (::loam::Registry::instance().add_kind(KIND, DOC), true);                    \
+#define LOAM_REGISTER_KIND(KIND, DOC)                             \
+  namespace {                                                     \
+  [[maybe_unused]] const bool LOAM_CONCAT(loam_kind_, __LINE__) = \
+      (::loam::Registry::instance().add_kind(KIND, DOC), true);   \
   }

@@ -54,7 +54,9 @@ struct Probe {
 };
 
 /// Output fields that are not stored but derived when written.
-bool derived_field(const std::string& name) { return name == "displacement"; }
+bool derived_field(const std::string& name) {
+  return name == "displacement";
+}
 
 template <int D>
 class Run {
@@ -123,8 +125,10 @@ class Run {
     bool need_disp = false;
     for (size_t i = 0; i < names.size(); ++i)
       if (check_name(out, i, names[i], false)) {
-        if (derived_field(names[i])) need_disp = true;
-        else if (names[i] != "position") frame_fields_.push_back(p.find(names[i]));
+        if (derived_field(names[i]))
+          need_disp = true;
+        else if (names[i] != "position")
+          frame_fields_.push_back(p.find(names[i]));
       }
     for (const auto& pr : cfg_.params.list("probes")) {
       Probe<D> probe;
@@ -149,7 +153,8 @@ class Run {
           if (k < 0 || k >= sim_->grid.nodes[d] || std::fabs(ijk[size_t(d)] - double(k)) > 1e-9) {
             diag.error(pr.where("node"), pr.path("node"),
                        "node index " + format_number(ijk[size_t(d)]) + " along " + "xyz"[d] +
-                           " is not an integer in [0, " + std::to_string(sim_->grid.nodes[d] - 1) + "]");
+                           " is not an integer in [0, " + std::to_string(sim_->grid.nodes[d] - 1) +
+                           "]");
           }
           idx += size_t(std::max(0L, k)) * size_t(sim_->grid.node_stride[d]);
         }
@@ -174,10 +179,13 @@ class Run {
           diag.error(cfg_.params.where("probes"), "probes." + std::to_string(i) + ".name",
                      "duplicate probe name '" + probes_[i].name + "'");
     if (need_disp) {
-      initial_position_ = p.request({"initial_position", D, "m", "position at t = 0", Particles<D>::axis_names()});
-      displacement_ = p.request({"displacement", D, "m", "position minus initial position", Particles<D>::axis_names()});
+      initial_position_ =
+          p.request({"initial_position", D, "m", "position at t = 0", Particles<D>::axis_names()});
+      displacement_ = p.request(
+          {"displacement", D, "m", "position minus initial position", Particles<D>::axis_names()});
       for (int d = 0; d < D; ++d)
-        std::copy(p.col(p.position, d), p.col(p.position, d) + p.size(), p.col(initial_position_, d));
+        std::copy(p.col(p.position, d), p.col(p.position, d) + p.size(),
+                  p.col(initial_position_, d));
       for (const auto& n : names)
         if (n == "displacement") frame_fields_.push_back(displacement_);
     }
@@ -186,7 +194,8 @@ class Run {
   std::string prepare_directory() {
     dir_ = opt_.out_dir.empty() ? fs::path("results") / cfg_.name : fs::path(opt_.out_dir);
     std::error_code ec;
-    if (fs::exists(dir_) && !fs::is_directory(dir_)) return "output path " + dir_.string() + " is a file";
+    if (fs::exists(dir_) && !fs::is_directory(dir_))
+      return "output path " + dir_.string() + " is a file";
     if (fs::exists(dir_) && !fs::is_empty(dir_)) {
       if (!opt_.overwrite)
         return "output directory " + dir_.string() +
@@ -215,11 +224,14 @@ class Run {
   }
 
   void open_outputs() {
-    writer_ = Registry::instance().create<Writer, D>(cfg_.params.section("output").section("writer"));
+    writer_ =
+        Registry::instance().create<Writer, D>(cfg_.params.section("output").section("writer"));
     writer_->open(dir_.string(), *sim_, frame_fields_);
     history_.open(dir_ / "history.csv");
     history_.out() << "step,time,dt,kinetic_energy,strain_energy,gravity_energy,total_energy";
-    for (int d = 0; d < D; ++d) history_.out() << ",momentum_" << "xyz"[d];
+    for (int d = 0; d < D; ++d)
+      history_.out() << ",momentum_"
+                     << "xyz"[d];
     history_.out() << "\n";
     for (auto& pr : probes_) {
       pr.csv.open(dir_ / ("probe_" + pr.name + ".csv"));
@@ -348,7 +360,8 @@ class Run {
         sample_probes(last);
         if (frame_due || last) {
           write_frame("");
-          while (every_time > 0 && next_frame_time <= sim.time * (1 + 1e-9)) next_frame_time += every_time;
+          while (every_time > 0 && next_frame_time <= sim.time * (1 + 1e-9))
+            next_frame_time += every_time;
         }
         if ((history_every > 0 && sim.step % history_every == 0) ||
             (history_every == 0 && (frame_due || last)))
@@ -382,10 +395,11 @@ class Run {
     if (sim.profiling) res.summary["profile_seconds"] = sim.profile;
     Energies e1 = sim.energies();
     auto energy_json = [](const Energies& e) {
-      return nlohmann::json{{"kinetic", e.kinetic},
-                            {"strain", std::isnan(e.strain) ? nlohmann::json() : nlohmann::json(e.strain)},
-                            {"gravity", e.gravity},
-                            {"momentum", e.momentum}};
+      return nlohmann::json{
+          {"kinetic", e.kinetic},
+          {"strain", std::isnan(e.strain) ? nlohmann::json() : nlohmann::json(e.strain)},
+          {"gravity", e.gravity},
+          {"momentum", e.momentum}};
     };
     res.summary["energy_initial"] = energy_json(e0);
     res.summary["energy_final"] = energy_json(e1);
@@ -397,9 +411,10 @@ class Run {
     }
     if (!failure.empty()) {
       res.exit_code = 3;
-      res.message = "loam: error: unstable run at step " + std::to_string(sim.step) +
-                    ", t = " + format_number(sim.time) + " s: " + failure +
-                    (files ? "; the state at detection was written as the last frame ('failed')" : "") + "\n";
+      res.message =
+          "loam: error: unstable run at step " + std::to_string(sim.step) +
+          ", t = " + format_number(sim.time) + " s: " + failure +
+          (files ? "; the state at detection was written as the last frame ('failed')" : "") + "\n";
       res.summary["failure"] = res.message;
       if (files) write_frame("failed");
     }
@@ -416,9 +431,10 @@ class Run {
       fs::rename(tmp, dir_ / "summary.json");
     }
     if (!opt_.quiet && failure.empty())
-      spdlog::info("done: {} steps, {} particles, {:.3g} s wall, {:.3g} M particle-steps/s on {} thread(s)",
-                   sim.step, sim.particles.size(), wall,
-                   res.summary["particle_steps_per_second"].get<double>() / 1e6, sim.threads);
+      spdlog::info(
+          "done: {} steps, {} particles, {:.3g} s wall, {:.3g} M particle-steps/s on {} thread(s)",
+          sim.step, sim.particles.size(), wall,
+          res.summary["particle_steps_per_second"].get<double>() / 1e6, sim.threads);
     return res;
   }
 };
@@ -431,9 +447,12 @@ RunResult run_dim(const LoadedConfig& cfg, const RunOptions& opt, bool check_onl
 
 RunResult dispatch(const LoadedConfig& cfg, const RunOptions& opt, bool check_only) {
   switch (cfg.dimension) {
-    case 1: return run_dim<1>(cfg, opt, check_only);
-    case 2: return run_dim<2>(cfg, opt, check_only);
-    case 3: return run_dim<3>(cfg, opt, check_only);
+    case 1:
+      return run_dim<1>(cfg, opt, check_only);
+    case 2:
+      return run_dim<2>(cfg, opt, check_only);
+    case 3:
+      return run_dim<3>(cfg, opt, check_only);
   }
   RunResult r;
   r.exit_code = 2;
@@ -443,8 +462,12 @@ RunResult dispatch(const LoadedConfig& cfg, const RunOptions& opt, bool check_on
 
 }  // namespace
 
-RunResult run_config(const LoadedConfig& cfg, const RunOptions& opt) { return dispatch(cfg, opt, false); }
-RunResult check_config(const LoadedConfig& cfg) { return dispatch(cfg, RunOptions{}, true); }
+RunResult run_config(const LoadedConfig& cfg, const RunOptions& opt) {
+  return dispatch(cfg, opt, false);
+}
+RunResult check_config(const LoadedConfig& cfg) {
+  return dispatch(cfg, RunOptions{}, true);
+}
 
 int run_file(const std::string& file, const RunOptions& opt) {
   Diagnostics diag;

@@ -20,8 +20,8 @@ constexpr int kBlock = 64;
 
 template <int D>
 struct StencilBlock {
-  int count = 0;  // particles in this block
-  int npp = 0;    // stencil entries per particle
+  int count = 0;              // particles in this block
+  int npp = 0;                // stencil entries per particle
   std::vector<int32_t> node;  // [k*kBlock + p]
   std::vector<double> w;      // [k*kBlock + p]
   std::vector<double> grad;   // [(k*D + d)*kBlock + p]
@@ -49,24 +49,30 @@ class ShapeFunction {
   /// Request particle fields (e.g. particle domain sizes) and check the set-up.
   virtual void setup(Simulation<D>&, Diagnostics&) {}
   /// Fill `out` for particles [begin, begin + count), count <= kBlock.
-  virtual void evaluate(const Grid<D>& grid, const Particles<D>& particles, size_t begin,
-                        int count, StencilBlock<D>& out) const = 0;
+  virtual void evaluate(const Grid<D>& grid, const Particles<D>& particles, size_t begin, int count,
+                        StencilBlock<D>& out) const = 0;
 };
 
 }  // namespace loam
 
 namespace loam {
 
-constexpr int ipow(int b, int e) { return e == 0 ? 1 : b * ipow(b, e - 1); }
+constexpr int ipow(int b, int e) {
+  return e == 0 ? 1 : b * ipow(b, e - 1);
+}
 
 /// Call f(std::integral_constant<int, NPP>) with the stencil size as a compile-time constant for
 /// the common sizes (2^D, 3^D, 4^D), so inner loops unroll; NPP = 0 means "use the runtime count".
 template <int D, class F>
 void with_stencil_size(int npp, F&& f) {
-  if (npp == ipow(2, D)) f(std::integral_constant<int, ipow(2, D)>{});
-  else if (npp == ipow(3, D)) f(std::integral_constant<int, ipow(3, D)>{});
-  else if (npp == ipow(4, D)) f(std::integral_constant<int, ipow(4, D)>{});
-  else f(std::integral_constant<int, 0>{});
+  if (npp == ipow(2, D))
+    f(std::integral_constant<int, ipow(2, D)>{});
+  else if (npp == ipow(3, D))
+    f(std::integral_constant<int, ipow(3, D)>{});
+  else if (npp == ipow(4, D))
+    f(std::integral_constant<int, ipow(4, D)>{});
+  else
+    f(std::integral_constant<int, 0>{});
 }
 
 }  // namespace loam

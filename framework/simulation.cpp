@@ -28,7 +28,8 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   mass_tolerance = num.real("mass_tolerance");
   for (const auto& s : config.list("particle_sets")) {
     Vec lo{}, hi{};
-    for (int d = 0; d < D; ++d) lo[size_t(d)] = s.vec("min")[size_t(d)], hi[size_t(d)] = s.vec("max")[size_t(d)];
+    for (int d = 0; d < D; ++d)
+      lo[size_t(d)] = s.vec("min")[size_t(d)], hi[size_t(d)] = s.vec("max")[size_t(d)];
     sets_.push_back({s.text("name"), {lo, hi}});
   }
   // From here on, keep checking after an error wherever the rest does not depend on it, so that
@@ -45,8 +46,8 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   bool particle_loads = false;
   for (auto& l : loads) particle_loads = particle_loads || l->uses_particle_forces();
   if (particle_loads)
-    external_force = particles.request({"external_force", D, "N", "applied external force",
-                                        Particles<D>::axis_names()});
+    external_force = particles.request(
+        {"external_force", D, "N", "applied external force", Particles<D>::axis_names()});
   sort();
   for (auto& b : boundaries) b->setup(*this, diag);
   model_checked = true;
@@ -74,10 +75,12 @@ void Simulation<D>::build_grid(const Params& g, Diagnostics& diag) {
     if (ratio < 1 - 1e-6) {  // not even one whole cell
       diag.error(g.where("cell_size"), g.path("cell_size"),
                  std::string("the grid has zero cells along ") + axis[0] + " (extent " +
-                     format_number(e[size_t(d)]) + " m < cell_size " + format_number(h[size_t(d)]) + " m)");
+                     format_number(e[size_t(d)]) + " m < cell_size " + format_number(h[size_t(d)]) +
+                     " m)");
     } else if (std::fabs(ratio - std::round(ratio)) > 1e-6 * ratio) {
-      spdlog::warn("grid: extent along {} is not a multiple of cell_size; using {} cells of {:.6g} m",
-                   axis[0], std::lround(ratio), e[size_t(d)] / double(std::lround(ratio)));
+      spdlog::warn(
+          "grid: extent along {} is not a multiple of cell_size; using {} cells of {:.6g} m",
+          axis[0], std::lround(ratio), e[size_t(d)] / double(std::lround(ratio)));
     }
   }
   if (diag.ok()) grid.init(o, e, h);
@@ -148,8 +151,10 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
       s[size_t(d)] = grid.cell[size_t(d)] / ppc;
       vol *= s[size_t(d)];
       // Lattice points origin + (i + 1/2) s inside [lo, hi].
-      i0[size_t(d)] = long(std::ceil((lo[size_t(d)] - grid.origin[size_t(d)]) / s[size_t(d)] - 0.5 - 1e-9));
-      i1[size_t(d)] = long(std::floor((hi[size_t(d)] - grid.origin[size_t(d)]) / s[size_t(d)] - 0.5 + 1e-9));
+      i0[size_t(d)] =
+          long(std::ceil((lo[size_t(d)] - grid.origin[size_t(d)]) / s[size_t(d)] - 0.5 - 1e-9));
+      i1[size_t(d)] =
+          long(std::floor((hi[size_t(d)] - grid.origin[size_t(d)]) / s[size_t(d)] - 0.5 + 1e-9));
     }
     std::array<long, D> i = i0;
     bool empty_range = false;
@@ -159,7 +164,8 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
     phi.fill(-1e300);
     while (!empty_range) {
       Vec x{};
-      for (int d = 0; d < D; ++d) x[size_t(d)] = grid.origin[size_t(d)] + (double(i[size_t(d)]) + 0.5) * s[size_t(d)];
+      for (int d = 0; d < D; ++d)
+        x[size_t(d)] = grid.origin[size_t(d)] + (double(i[size_t(d)]) + 0.5) * s[size_t(d)];
       if (gen->contains(x)) {
         xs.push_back(x);
         owner.push_back(uint16_t(b));

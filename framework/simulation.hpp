@@ -20,8 +20,8 @@
 #include "load.hpp"
 #include "material.hpp"
 #include "params.hpp"
-#include "partition.hpp"
 #include "particles.hpp"
+#include "partition.hpp"
 #include "reference.hpp"
 #include "scheme.hpp"
 #include "shape_function.hpp"
@@ -99,9 +99,13 @@ class Simulation {
     if (damping) damping->apply(*this, nf);
   }
   template <class F>
-  void scatter_blocks(F&& f) const { partition.scatter_blocks(std::forward<F>(f)); }
+  void scatter_blocks(F&& f) const {
+    partition.scatter_blocks(std::forward<F>(f));
+  }
   template <class F>
-  void gather_blocks(F&& f) const { partition.gather_blocks(std::forward<F>(f)); }
+  void gather_blocks(F&& f) const {
+    partition.gather_blocks(std::forward<F>(f));
+  }
 
   // --------------------------------------------------------- loop pieces (used by the runner)
   double stable_dt() const;

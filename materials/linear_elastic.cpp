@@ -14,7 +14,8 @@ template <int D>
 class LinearElastic : public Material<D> {
  public:
   static constexpr const char* name = "linear_elastic";
-  static constexpr const char* summary = "isotropic linear elasticity, Jaumann rate (large rotations)";
+  static constexpr const char* summary =
+      "isotropic linear elasticity, Jaumann rate (large rotations)";
   static Schema schema() {
     Schema s;
     s.real("E", "Pa", "Young's modulus").required().positive();

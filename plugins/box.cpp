@@ -21,7 +21,8 @@ class Box : public Generator<D> {
     return s;
   }
   explicit Box(const Params& p) {
-    for (int d = 0; d < D; ++d) lo_[size_t(d)] = p.vec("min")[size_t(d)], hi_[size_t(d)] = p.vec("max")[size_t(d)];
+    for (int d = 0; d < D; ++d)
+      lo_[size_t(d)] = p.vec("min")[size_t(d)], hi_[size_t(d)] = p.vec("max")[size_t(d)];
   }
   bool contains(const std::array<double, D>& x) const override {
     for (int d = 0; d < D; ++d)

@@ -14,7 +14,8 @@ template <int D>
 class ElasticColumn : public Reference<D> {
  public:
   static constexpr const char* name = "elastic_column";
-  static constexpr const char* summary = "confined elastic column under self-weight: stress and settlement";
+  static constexpr const char* summary =
+      "confined elastic column under self-weight: stress and settlement";
   static Schema schema() {
     Schema s;
     s.text("body", "the column (default: the first body)");
@@ -25,13 +26,15 @@ class ElasticColumn : public Reference<D> {
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     body_ = params_.has("body") ? sim.body_index(params_.text("body")) : 0;
     if (body_ < 0) {
-      diag.error(params_.where("body"), params_.path("body"), "unknown body '" + params_.text("body") + "'");
+      diag.error(params_.where("body"), params_.path("body"),
+                 "unknown body '" + params_.text("body") + "'");
       return;
     }
     const Body& b = sim.bodies[size_t(body_)];
     const Params& mat = b.params.section("material");
     if (!mat.has("E") || !mat.has("nu")) {
-      diag.error(params_.where(), params_.path(), "elastic_column needs an elastic body with 'E' and 'nu'");
+      diag.error(params_.where(), params_.path(),
+                 "elastic_column needs an elastic body with 'E' and 'nu'");
       return;
     }
     E_ = mat.real("E");
@@ -49,9 +52,10 @@ class ElasticColumn : public Reference<D> {
 
   std::map<std::string, double> metrics(Simulation<D>& sim) override {
     const auto& P = sim.particles;
-    const int v_comp = D - 1;             // Voigt index of sigma along the last axis
-    const int h_comp = D == 1 ? 1 : 0;    // a lateral normal stress
-    double mean_sv = 0, vol = 0, e2 = 0, r2 = 0, h2 = 0, hr2 = 0, u2 = 0, ur2 = 0, top_u = 0, top_z = -1e300;
+    const int v_comp = D - 1;           // Voigt index of sigma along the last axis
+    const int h_comp = D == 1 ? 1 : 0;  // a lateral normal stress
+    double mean_sv = 0, vol = 0, e2 = 0, r2 = 0, h2 = 0, hr2 = 0, u2 = 0, ur2 = 0, top_u = 0,
+           top_z = -1e300;
     for (size_t i = 0; i < P.size(); ++i) {
       if (P.body[i] != body_) continue;
       const double V = P.col(P.volume)[i];

@@ -9,17 +9,22 @@ template <int D>
 class LinearProfile : public Field<D> {
  public:
   static constexpr const char* name = "linear_profile";
-  static constexpr const char* summary = "value + gradient * (x[axis] - origin), e.g. geostatic stress";
+  static constexpr const char* summary =
+      "value + gradient * (x[axis] - origin), e.g. geostatic stress";
   static Schema schema() {
     Schema s;
     s.vector("value", "(field unit)", "value at the origin", kFieldComponents).required();
-    s.vector("gradient", "(field unit)/m", "change per metre along the axis", kFieldComponents).required();
+    s.vector("gradient", "(field unit)/m", "change per metre along the axis", kFieldComponents)
+        .required();
     s.integer("axis", "axis index (0: x, 1: y, 2: z)").required().min(0).max(2);
     s.real("origin", "m", "coordinate along the axis where the field equals value").def("0");
     return s;
   }
   explicit LinearProfile(const Params& p)
-      : v_(p.vec("value")), g_(p.vec("gradient")), axis_(int(p.integer("axis"))), x0_(p.real("origin")) {
+      : v_(p.vec("value")),
+        g_(p.vec("gradient")),
+        axis_(int(p.integer("axis"))),
+        x0_(p.real("origin")) {
     if (axis_ >= D) axis_ = D - 1;
   }
   void value(const std::array<double, D>& x, double* out) const override {

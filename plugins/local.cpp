@@ -12,10 +12,14 @@ template <int D>
 class LocalDamping : public Damping<D> {
  public:
   static constexpr const char* name = "local";
-  static constexpr const char* summary = "Cundall local damping: f -= alpha |f| sign(v) at each node";
+  static constexpr const char* summary =
+      "Cundall local damping: f -= alpha |f| sign(v) at each node";
   static Schema schema() {
     Schema s;
-    s.real("alpha", "-", "damping coefficient (0: none; 0.1-0.8 typical)").required().min(0).below(1);
+    s.real("alpha", "-", "damping coefficient (0: none; 0.1-0.8 typical)")
+        .required()
+        .min(0)
+        .below(1);
     return s;
   }
   explicit LocalDamping(const Params& p) : alpha_(p.real("alpha")) {}

@@ -9,7 +9,8 @@ template <int D>
 class PointLoad : public Load<D> {
  public:
   static constexpr const char* name = "point";
-  static constexpr const char* summary = "point force at a fixed position, spread to its cell's nodes";
+  static constexpr const char* summary =
+      "point force at a fixed position, spread to its cell's nodes";
   static Schema schema() {
     Schema s;
     s.vector("position", "m", "where the force acts").required();
@@ -25,7 +26,8 @@ class PointLoad : public Load<D> {
   }
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     if (!sim.grid.inside(x_)) {
-      diag.error(params_.where("position"), params_.path("position"), "the point is outside the grid");
+      diag.error(params_.where("position"), params_.path("position"),
+                 "the point is outside the grid");
       return;
     }
     const auto& g = sim.grid;

@@ -20,7 +20,8 @@ class Polygon : public Generator<D> {
   }
   explicit Polygon(const Params& p) : v_(p.vecs("vertices")) {}
   std::string check() const override {
-    return D == 2 ? "" : "a polygon generator needs a 2D grid (this one is " + std::to_string(D) + "D)";
+    return D == 2 ? ""
+                  : "a polygon generator needs a 2D grid (this one is " + std::to_string(D) + "D)";
   }
   bool contains(const std::array<double, D>& x) const override {
     if constexpr (D != 2) {
@@ -44,7 +45,9 @@ class Polygon : public Generator<D> {
     std::array<double, D> b{};
     for (int d = 0; d < std::min(D, 2); ++d) {
       b[size_t(d)] = v_[0][size_t(d)];
-      for (const auto& p : v_) b[size_t(d)] = up ? std::max(b[size_t(d)], p[size_t(d)]) : std::min(b[size_t(d)], p[size_t(d)]);
+      for (const auto& p : v_)
+        b[size_t(d)] =
+            up ? std::max(b[size_t(d)], p[size_t(d)]) : std::min(b[size_t(d)], p[size_t(d)]);
     }
     return b;
   }

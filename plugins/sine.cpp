@@ -14,12 +14,14 @@ class Sine : public Field<D> {
   static constexpr const char* summary = "amplitude * sin(wavenumber . (x - origin))";
   static Schema schema() {
     Schema s;
-    s.vector("amplitude", "(field unit)", "amplitude of each component", kFieldComponents).required();
+    s.vector("amplitude", "(field unit)", "amplitude of each component", kFieldComponents)
+        .required();
     s.vector("wavenumber", "1/m", "wave vector k").required();
     s.vector("origin", "m", "point where the sine is zero").def("0").scalar_ok();
     return s;
   }
-  explicit Sine(const Params& p) : a_(p.vec("amplitude")), k_(p.vec("wavenumber")), x0_(p.vec("origin")) {}
+  explicit Sine(const Params& p)
+      : a_(p.vec("amplitude")), k_(p.vec("wavenumber")), x0_(p.vec("origin")) {}
   void value(const std::array<double, D>& x, double* out) const override {
     double phase = 0;
     for (int d = 0; d < D; ++d) phase += k_[size_t(d)] * (x[size_t(d)] - x0_[size_t(d)]);

@@ -9,7 +9,8 @@ template <int D>
 class Slip : public Boundary<D> {
  public:
   static constexpr const char* name = "slip";
-  static constexpr const char* summary = "roller grid face: normal velocity zero (or chosen components)";
+  static constexpr const char* summary =
+      "roller grid face: normal velocity zero (or chosen components)";
   static Schema schema() {
     Schema s;
     s.choice("face", face_names(), "grid face").required();
@@ -30,7 +31,8 @@ class Slip : public Boundary<D> {
         diag.error(params_.where("directions"), params_.path("directions"),
                    "unknown direction '" + c + "' (use x" + (D > 1 ? ", y" : "") +
                        (D > 2 ? ", z" : "") + ")");
-      else fixed_.push_back(axis);
+      else
+        fixed_.push_back(axis);
     }
   }
   void constrain(const NodalVector& v) const override {

@@ -20,7 +20,8 @@ class Sphere : public Generator<D> {
   }
   bool contains(const std::array<double, D>& x) const override {
     double r2 = 0;
-    for (int d = 0; d < D; ++d) r2 += (x[size_t(d)] - c_[size_t(d)]) * (x[size_t(d)] - c_[size_t(d)]);
+    for (int d = 0; d < D; ++d)
+      r2 += (x[size_t(d)] - c_[size_t(d)]) * (x[size_t(d)] - c_[size_t(d)]);
     return r2 <= r_ * r_;
   }
   std::array<double, D> lower() const override {

@@ -10,7 +10,8 @@ template <int D>
 class Traction : public Load<D> {
  public:
   static constexpr const char* name = "traction";
-  static constexpr const char* summary = "traction on a body face or particle set, with a time ramp";
+  static constexpr const char* summary =
+      "traction on a body face or particle set, with a time ramp";
   static Schema schema() {
     Schema s;
     s.text("body", "body whose face is loaded");
@@ -36,7 +37,8 @@ class Traction : public Load<D> {
     const auto& P = sim.particles;
     if (params_.has("set")) {
       if (!sim.particle_set(params_.text("set"), ids_)) {
-        diag.error(params_.where("set"), params_.path("set"), "unknown particle set '" + params_.text("set") + "'");
+        diag.error(params_.where("set"), params_.path("set"),
+                   "unknown particle set '" + params_.text("set") + "'");
         return;
       }
     } else {
@@ -49,7 +51,8 @@ class Traction : public Load<D> {
         return;
       }
       const Body& body = sim.bodies[size_t(b)];
-      const double plane = face_.upper ? body.upper[size_t(face_.axis)] : body.lower[size_t(face_.axis)];
+      const double plane =
+          face_.upper ? body.upper[size_t(face_.axis)] : body.lower[size_t(face_.axis)];
       const double half = 0.5 * body.spacing[size_t(face_.axis)];
       for (size_t i = 0; i < P.size(); ++i)
         if (P.body[i] == b && std::fabs(P.col(P.position, face_.axis)[i] - plane) < half * 1.001)

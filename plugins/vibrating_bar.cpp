@@ -24,7 +24,8 @@ class VibratingBar : public Reference<D> {
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     body_ = params_.has("body") ? sim.body_index(params_.text("body")) : 0;
     if (body_ < 0) {
-      diag.error(params_.where("body"), params_.path("body"), "unknown body '" + params_.text("body") + "'");
+      diag.error(params_.where("body"), params_.path("body"),
+                 "unknown body '" + params_.text("body") + "'");
       return;
     }
     const Body& b = sim.bodies[size_t(body_)];
@@ -39,7 +40,8 @@ class VibratingBar : public Reference<D> {
     double best = -1e300;
     const auto& P = sim.particles;
     for (size_t i = 0; i < P.size(); ++i)
-      if (P.body[i] == body_ && P.col(P.position, 0)[i] > best) best = P.col(P.position, 0)[i], tip_ = P.id[i];
+      if (P.body[i] == body_ && P.col(P.position, 0)[i] > best)
+        best = P.col(P.position, 0)[i], tip_ = P.id[i];
     x_tip0_ = best;
     e0_ = energy(sim);
   }

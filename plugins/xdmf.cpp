@@ -89,7 +89,8 @@ class Xdmf : public Writer<D> {
     H5Sclose(space);
   }
 
-  static void write_columns(hid_t f, const std::string& name, const Particles<D>& P, int h, int width) {
+  static void write_columns(hid_t f, const std::string& name, const Particles<D>& P, int h,
+                            int width) {
     const size_t n = P.size();
     const int nc = P.info(h).components;
     std::vector<double> buf(n * size_t(width), 0.0);
@@ -132,11 +133,12 @@ class Xdmf : public Writer<D> {
       << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << file << ":/" << prefix
       << "position</DataItem></Geometry>\n";
     for (const auto& a : attrs) {
-      x << "        <Attribute Name=\"" << a.name << "\" AttributeType=\"" << attribute_type(a.width)
-        << "\" Center=\"Node\"><DataItem Dimensions=\"" << n;
+      x << "        <Attribute Name=\"" << a.name << "\" AttributeType=\""
+        << attribute_type(a.width) << "\" Center=\"Node\"><DataItem Dimensions=\"" << n;
       if (a.width > 1) x << " " << a.width;
-      x << "\" NumberType=\"" << a.number_type << "\" Precision=\"" << (a.number_type == "Int" ? 4 : 8)
-        << "\" Format=\"HDF\">" << file << ":/" << prefix << a.name << "</DataItem></Attribute>\n";
+      x << "\" NumberType=\"" << a.number_type << "\" Precision=\""
+        << (a.number_type == "Int" ? 4 : 8) << "\" Format=\"HDF\">" << file << ":/" << prefix
+        << a.name << "</DataItem></Attribute>\n";
     }
     x << "      </Grid>\n";
   }

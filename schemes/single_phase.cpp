@@ -58,8 +58,10 @@ class SinglePhase : public Scheme<D> {
   void step(Simulation<D>& sim, double dt) override {
     with_stencil_size<D>(sim.shape->nodes_per_particle(), [&](auto npp) {
       constexpr int NPP = decltype(npp)::value;
-      if (update_ == "usf") step_usf<NPP>(sim, dt);
-      else step_usl_musl<NPP>(sim, dt, update_ == "musl");
+      if (update_ == "usf")
+        step_usf<NPP>(sim, dt);
+      else
+        step_usl_musl<NPP>(sim, dt, update_ == "musl");
     });
   }
 
@@ -79,8 +81,12 @@ class SinglePhase : public Scheme<D> {
   };
   std::vector<std::unique_ptr<Scratch>> scratch_;
 
-  NodalVector node_vector(int offset) { return NodalVector{node_.data(), S, offset}; }
-  NodalVector vel_vector() { return NodalVector{vel_.data(), D, 0}; }
+  NodalVector node_vector(int offset) {
+    return NodalVector{node_.data(), S, offset};
+  }
+  NodalVector vel_vector() {
+    return NodalVector{vel_.data(), D, 0};
+  }
 
   void zero(std::vector<double>& v, int threads) {
     const long n = long(v.size());
@@ -122,7 +128,8 @@ class SinglePhase : public Scheme<D> {
         }
         if constexpr (FORCE) {
           double gr[D];
-          for (int j = 0; j < D; ++j) gr[j] = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
+          for (int j = 0; j < D; ++j)
+            gr[j] = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
           for (int d = 0; d < D; ++d) {
             double f = w * body[d];
             for (int j = 0; j < D; ++j) f -= sv[d][j] * gr[j];  // f_int = -V sigma . grad N
@@ -136,8 +143,8 @@ class SinglePhase : public Scheme<D> {
   /// Nodal forces to updated velocity and acceleration, with loads, damping and constraints.
   void integrate(Simulation<D>& sim, double dt) {
     sim.apply_grid_loads(node_vector(1 + D));
-    sim.apply_damping(NodeForces{node_.data(), node_vector(1), node_vector(1 + D),
-                                 sim.grid.num_nodes, S});
+    sim.apply_damping(
+        NodeForces{node_.data(), node_vector(1), node_vector(1 + D), sim.grid.num_nodes, S});
     const long n = long(sim.grid.num_nodes);
     const double tol = sim.mass_tolerance;
     double* g = node_.data();
@@ -338,7 +345,9 @@ class SinglePhase : public Scheme<D> {
       });
       sim.timed("grid", [&] { momentum_to_velocity(sim, vel_.data(), D, 0); });
       sim.timed("g2p_gradient_stress", [&] {
-        sim.gather_blocks([&](size_t b, int c, int t) { update_stress<NPP, Gradient::kRemapped>(sim, dt, b, c, t); });
+        sim.gather_blocks([&](size_t b, int c, int t) {
+          update_stress<NPP, Gradient::kRemapped>(sim, dt, b, c, t);
+        });
       });
     } else {
       // USL: gradient, move and velocity update from the updated grid record in one pass.
@@ -357,7 +366,8 @@ class SinglePhase : public Scheme<D> {
     zero(node_, sim.threads);
     sim.scatter_blocks([&](size_t b, int c, int t) { scatter<NPP, true, false>(sim, b, c, t); });
     momentum_to_velocity(sim, node_.data(), S, 1);
-    sim.gather_blocks([&](size_t b, int c, int t) { update_stress<NPP, Gradient::kCurrent>(sim, dt, b, c, t); });
+    sim.gather_blocks(
+        [&](size_t b, int c, int t) { update_stress<NPP, Gradient::kCurrent>(sim, dt, b, c, t); });
     sim.scatter_blocks([&](size_t b, int c, int t) { scatter<NPP, false, true>(sim, b, c, t); });
     integrate(sim, dt);
     reset_max_speed();

@@ -28,7 +28,8 @@ inline CliResult run_loam(const std::string& args) {
 struct TempDir {
   std::filesystem::path path;
   explicit TempDir(const std::string& name) {
-    path = std::filesystem::temp_directory_path() / ("loam_test_" + name + "_" + std::to_string(getpid()));
+    path = std::filesystem::temp_directory_path() /
+           ("loam_test_" + name + "_" + std::to_string(getpid()));
     std::filesystem::remove_all(path);
   }
   ~TempDir() { std::filesystem::remove_all(path); }
@@ -37,8 +38,8 @@ struct TempDir {
 /// Run a config from configs/ (with extra arguments) into `out` and return its summary.json.
 inline nlohmann::json run_scene(const std::string& config, const std::filesystem::path& out,
                                 const std::string& extra = "") {
-  CliResult r = run_loam(std::string("run ") + LOAM_SOURCE_DIR + "/configs/" + config + " --quiet --out " +
-                         out.string() + " " + extra);
+  CliResult r = run_loam(std::string("run ") + LOAM_SOURCE_DIR + "/configs/" + config +
+                         " --quiet --out " + out.string() + " " + extra);
   if (r.exit_code != 0) throw std::runtime_error("loam run " + config + " failed:\n" + r.output);
   std::ifstream in(out / "summary.json");
   return nlohmann::json::parse(in);

@@ -33,3 +33,21 @@ TEST_CASE("framework/ includes nothing from plugin directories and names no plug
   }
   CHECK(files > 10);
 }
+
+TEST_CASE("docs/plugins.md and docs/config.md are generated from the current schemas", "[layout]") {
+  // Regenerate with: build/loam plugins --markdown > docs/plugins.md;
+  //                  build/loam schema --markdown > docs/config.md
+  for (auto [cmd, file] : {std::pair<std::string, std::string>{"plugins --markdown", "plugins.md"},
+                           std::pair<std::string, std::string>{"schema --markdown", "config.md"}}) {
+    std::string out;
+    FILE* pipe = popen((std::string(LOAM_EXE) + " " + cmd).c_str(), "r");
+    char buf[4096];
+    while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
+    pclose(pipe);
+    std::ifstream in(fs::path(LOAM_SOURCE_DIR) / "docs" / file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    INFO("docs/" << file << " is stale: regenerate it with `loam " << cmd << "`");
+    CHECK(ss.str() == out);
+  }
+}

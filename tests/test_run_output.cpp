@@ -18,13 +18,14 @@ static std::string slurp(const std::filesystem::path& p) {
 
 TEST_CASE("a run writes XDMF frames, probes, history and a complete summary", "[output]") {
   TempDir dir("output");
-  auto r = run_loam(std::string("run ") + LOAM_SOURCE_DIR +
-                    "/configs/vibrating_bar.yaml --quiet --set time.end=20 --out " + dir.path.string());
+  auto r =
+      run_loam(std::string("run ") + LOAM_SOURCE_DIR +
+               "/configs/vibrating_bar.yaml --quiet --set time.end=20 --out " + dir.path.string());
   REQUIRE(r.exit_code == 0);
   auto s = nlohmann::json::parse(slurp(dir.path / "summary.json"));
-  for (const char* key : {"loam_version", "git_commit", "config", "dimension", "particles", "cells",
-                          "steps", "end_time", "wall_seconds", "threads",
-                          "particle_steps_per_second", "verify"})
+  for (const char* key :
+       {"loam_version", "git_commit", "config", "dimension", "particles", "cells", "steps",
+        "end_time", "wall_seconds", "threads", "particle_steps_per_second", "verify"})
     CHECK(s.contains(key));
   CHECK(s["config"]["time"]["end"].get<double>() == 20.0);  // echo after overrides
   CHECK(s["config"]["scheme"]["update"] == "musl");         // and with defaults filled in
@@ -56,13 +57,15 @@ TEST_CASE("an unstable run stops with exit 3 naming step, time, particle and fie
                     dir.path.string());
   INFO(r.output);
   CHECK(r.exit_code == 3);
-  std::regex pattern(R"(loam: error: unstable run at step \d+, t = [0-9.e+-]+ s: particle \d+ \(body 'column'\): (position|velocity|stress)\S* .*)");
+  std::regex pattern(
+      R"(loam: error: unstable run at step \d+, t = [0-9.e+-]+ s: particle \d+ \(body 'column'\): (position|velocity|stress)\S* .*)");
   CHECK(std::regex_search(r.output, pattern));
   auto s = nlohmann::json::parse(slurp(dir.path / "summary.json"));
   CHECK(s["status"] == "unstable");
   bool failed_frame = false;
   for (const auto& e : std::filesystem::directory_iterator(dir.path))
-    failed_frame = failed_frame || e.path().filename().string().find("_failed.h5") != std::string::npos;
+    failed_frame =
+        failed_frame || e.path().filename().string().find("_failed.h5") != std::string::npos;
   CHECK(failed_frame);
 }
 

@@ -10,17 +10,19 @@
 using loam_test::run_scene;
 using loam_test::TempDir;
 
-TEST_CASE("vibrating bar: period and energy over 10 periods (VERIFICATION.md A)", "[verification]") {
+TEST_CASE("vibrating bar: period and energy over 10 periods (VERIFICATION.md A)",
+          "[verification]") {
   // Reference: T = 4L/c = 10 s for L = 25 m, E = 100 Pa, rho = 1; MUSL, linear shape functions.
   // Tolerances from issue 3: period error < 1 %, total-energy drift < 1 % over 10 periods.
   TempDir dir("bar");
   auto s = run_scene("vibrating_bar.yaml", dir.path);
   auto v = s["verify"];
   double period_error = v["period_error"], drift = v["energy_drift"], amp = v["amplitude_error"];
-  std::printf("vibrating bar: period %.6f s (exact %.6f), error %.3e; energy drift %.3e; "
-              "tip amplitude error %.3e; %g periods observed\n",
-              v["period_measured"].get<double>(), v["period_exact"].get<double>(), period_error,
-              drift, amp, v["periods_observed"].get<double>());
+  std::printf(
+      "vibrating bar: period %.6f s (exact %.6f), error %.3e; energy drift %.3e; "
+      "tip amplitude error %.3e; %g periods observed\n",
+      v["period_measured"].get<double>(), v["period_exact"].get<double>(), period_error, drift, amp,
+      v["periods_observed"].get<double>());
   CHECK(v["periods_observed"].get<double>() >= 9);
   CHECK(period_error < 0.01);
   CHECK(drift < 0.01);
@@ -32,26 +34,29 @@ TEST_CASE("vibrating bar under USL and USF also keeps its period", "[verificatio
     TempDir dir("bar_" + update);
     auto s = run_scene("vibrating_bar.yaml", dir.path, "--set scheme.update=" + update);
     double e = s["verify"]["period_error"], drift = s["verify"]["energy_drift"];
-    std::printf("vibrating bar %s: period error %.3e, energy drift %.3e\n", update.c_str(), e, drift);
+    std::printf("vibrating bar %s: period error %.3e, energy drift %.3e\n", update.c_str(), e,
+                drift);
     CHECK(e < 0.01);
     CHECK(drift < 0.02);  // not an issue target; USL/USF must simply not drift far
   }
 }
 
-TEST_CASE("elastic column 1D/2D/3D: stress vs rho g (H - z) (VERIFICATION.md A)", "[verification]") {
+TEST_CASE("elastic column 1D/2D/3D: stress vs rho g (H - z) (VERIFICATION.md A)",
+          "[verification]") {
   // Tolerance from issue 3: relative L2 error of sigma_v < 3 %; 2D and 3D agree with 1D within 1 %.
   std::vector<nlohmann::json> v;
   for (int d = 1; d <= 3; ++d) {
     TempDir dir("column" + std::to_string(d));
     auto s = run_scene("elastic_column_" + std::to_string(d) + "d.yaml", dir.path);
     v.push_back(s["verify"]);
-    std::printf("elastic column %dD: sigma_v L2 error %.4f, sigma_h L2 error %.4f, displacement L2 "
-                "error %.2e, top settlement %.4e m (exact %.4e)\n",
-                d, s["verify"]["stress_error_l2"].get<double>(),
-                s["verify"]["horizontal_stress_error_l2"].get<double>(),
-                s["verify"]["displacement_error_l2"].get<double>(),
-                s["verify"]["settlement_top_particle"].get<double>(),
-                s["verify"]["settlement_exact"].get<double>());
+    std::printf(
+        "elastic column %dD: sigma_v L2 error %.4f, sigma_h L2 error %.4f, displacement L2 "
+        "error %.2e, top settlement %.4e m (exact %.4e)\n",
+        d, s["verify"]["stress_error_l2"].get<double>(),
+        s["verify"]["horizontal_stress_error_l2"].get<double>(),
+        s["verify"]["displacement_error_l2"].get<double>(),
+        s["verify"]["settlement_top_particle"].get<double>(),
+        s["verify"]["settlement_exact"].get<double>());
     CHECK(s["verify"]["stress_error_l2"].get<double>() < 0.03);
     CHECK(s["verify"]["horizontal_stress_error_l2"].get<double>() < 0.03);
   }
@@ -87,9 +92,10 @@ TEST_CASE("disk collision conserves momentum; MUSL energy loss reported", "[veri
   const double v = 0.1 * std::sqrt(2.0);
   const double m_disk = s["energy_initial"]["kinetic"].get<double>() / (v * v);
   const double p_scale = m_disk * v;
-  std::printf("disk collision: max |momentum| %.3e (scale %.3e); total energy: start %.5f, min %.5f "
-              "(-%.2f %%), end %.5f (-%.2f %%)\n",
-              p_max, p_scale, e0, e_min, 100 * (1 - e_min / e0), e_last, 100 * (1 - e_last / e0));
+  std::printf(
+      "disk collision: max |momentum| %.3e (scale %.3e); total energy: start %.5f, min %.5f "
+      "(-%.2f %%), end %.5f (-%.2f %%)\n",
+      p_max, p_scale, e0, e_min, 100 * (1 - e_min / e0), e_last, 100 * (1 - e_last / e0));
   CHECK(p_max < 1e-12 * p_scale);
   CHECK(e_last < e0 * (1 + 1e-9));  // MUSL never creates energy here
   CHECK(e_last > 0.95 * e0);        // and dissipates little over one collision
