@@ -119,6 +119,21 @@ class Particles {
     permute_int(body, order);
   }
 
+  /// The deformation gradient F (row-major D x D, F_ij at component i*D + j), created as the
+  /// identity on first request. Schemes update it with F <- (I + L dt) F when it exists, so it
+  /// costs nothing unless a plugin (CPDI, a hyperelastic material, ...) asks for it.
+  int request_deformation_gradient() {
+    const bool is_new = find("deformation_gradient") < 0;
+    std::vector<std::string> names;
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j) names.push_back(std::string(1, "xyz"[i]) + "xyz"[j]);
+    const int h = request({"deformation_gradient", D * D, "-", "deformation gradient F", names});
+    if (is_new)
+      for (int i = 0; i < D; ++i)
+        for (size_t p = 0; p < n_; ++p) col(h, i * D + i)[p] = 1.0;
+    return h;
+  }
+
   size_t bytes_per_particle() const {
     size_t b = sizeof(uint32_t) + 2 * sizeof(uint16_t);
     for (const auto& f : fields_) b += sizeof(double) * size_t(f.info.components);

@@ -56,6 +56,8 @@ class SinglePhase : public Scheme<D> {
   }
 
   void step(Simulation<D>& sim, double dt) override {
+    // Plugins may request F after this scheme's set-up; look it up once per step.
+    deformation_gradient_ = sim.particles.find("deformation_gradient");
     with_stencil_size<D>(sim.shape->nodes_per_particle(), [&](auto npp) {
       constexpr int NPP = decltype(npp)::value;
       if (update_ == "usf")
@@ -72,6 +74,7 @@ class SinglePhase : public Scheme<D> {
   static constexpr int NS = Particles<D>::NS;
   std::string update_;
   double flip_;
+  int deformation_gradient_ = -1;
   std::vector<double> node_;  // num_nodes * S
   std::vector<double> vel_;   // num_nodes * D: velocity used for the velocity gradient
   struct alignas(64) Scratch {
@@ -255,6 +258,9 @@ class SinglePhase : public Scheme<D> {
       v[size_t(d)] = P.col(P.velocity, d) + b;
     }
     const double* g = node_.data();
+    std::array<double*, D * D> F{};  // deformation gradient, if some plugin requested it
+    if (deformation_gradient_ >= 0)
+      for (int c = 0; c < D * D; ++c) F[size_t(c)] = P.col(deformation_gradient_, c) + b;
     // Source of the velocity field whose gradient is taken.
     const double* vel = kFromRecord ? node_.data() + 1 : vel_.data();
     const size_t vstride = kFromRecord ? S : D;
@@ -281,6 +287,7 @@ class SinglePhase : public Scheme<D> {
         for (int j = 0; j < D; ++j) L[size_t(i * D + j) * kBlock + size_t(p)] = l[i][j];
       // V^{n+1} = det(I + L dt) V^n
       V[p] *= det_increment(l, dt);
+      if (F[0]) update_deformation_gradient(F, l, dt, p);
       if constexpr (kMove)
         for (int d = 0; d < D; ++d) x[size_t(d)][p] += dt * vn[d];
       if constexpr (kFromRecord) {
@@ -301,6 +308,20 @@ class SinglePhase : public Scheme<D> {
     batch.L = L;
     batch.particles = &P;
     sim.materials[P.material[b]]->update_stress(batch);
+  }
+
+  /// F^{n+1} = (I + L dt) F^n for particle p of the block.
+  static void update_deformation_gradient(const std::array<double*, D * D>& F,
+                                          const double (&l)[D][D], double dt, int p) {
+    double f[D][D];
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j) f[i][j] = F[size_t(i * D + j)][p];
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j) {
+        double sum = f[i][j];
+        for (int k = 0; k < D; ++k) sum += l[i][k] * dt * f[k][j];
+        F[size_t(i * D + j)][p] = sum;
+      }
   }
 
   static double det_increment(const double (&l)[D][D], double dt) {
