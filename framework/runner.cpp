@@ -345,6 +345,11 @@ class Run {
       dt_min = std::min(dt_min, dt);
       dt_max = std::max(dt_max, dt);
       sim.prepare_particle_loads();
+      sim.shape->begin_step(sim);
+      if (!sim.failure.empty()) {
+        failure = sim.failure;
+        break;
+      }
       sim.scheme->step(sim, dt);
       sim.time += dt;
       ++sim.step;

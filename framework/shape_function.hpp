@@ -48,7 +48,12 @@ class ShapeFunction {
   virtual int rows_above() const = 0;
   /// Request particle fields (e.g. particle domain sizes) and check the set-up.
   virtual void setup(Simulation<D>&, Diagnostics&) {}
-  /// Fill `out` for particles [begin, begin + count), count <= kBlock.
+  /// Called before every step (e.g. to update particle domains and the reach reported by
+  /// rows_below/rows_above). A shape function that cannot continue (a particle domain too
+  /// distorted, ...) sets Simulation::failure; the run then stops with exit code 3.
+  virtual void begin_step(Simulation<D>&) {}
+  /// Fill `out` for particles [begin, begin + count), count <= kBlock. Stencil entries for nodes
+  /// outside the grid must carry a valid node index with zero weight and gradient.
   virtual void evaluate(const Grid<D>& grid, const Particles<D>& particles, size_t begin, int count,
                         StencilBlock<D>& out) const = 0;
 };

@@ -75,6 +75,9 @@ class Simulation {
   int external_force = -1;        // particle field handle, or -1 if no load uses it
   int initial_position = -1;      // for displacement output, or -1
   bool model_checked = false;     // grid and plugins were set up (output checks may run)
+  /// Set by a plugin that cannot continue (e.g. "particle 12: CPDI domain inverted"); the runner
+  /// stops with exit code 3 after the current step, naming step and time.
+  std::string failure;
 
   bool profiling = false;
   std::map<std::string, double> profile;  // seconds per phase, when profiling

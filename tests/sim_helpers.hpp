@@ -26,6 +26,8 @@ void advance(loam::Simulation<D>& sim, int steps) {
   for (int i = 0; i < steps; ++i) {
     sim.dt = sim.stable_dt();
     sim.prepare_particle_loads();
+    sim.shape->begin_step(sim);
+    if (!sim.failure.empty()) throw std::runtime_error(sim.failure);
     sim.scheme->step(sim, sim.dt);
     sim.time += sim.dt;
     ++sim.step;
