@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "bench/bench.hpp"
+#include "compare.hpp"
 #include "config.hpp"
 #include "docs.hpp"
 #include "runner.hpp"
@@ -43,6 +44,18 @@ int main(int argc, char** argv) {
   bool schema_md = false;
   auto* schema = app.add_subcommand("schema", "list the keys of a run file");
   schema->add_flag("--markdown", schema_md, "Markdown output");
+
+  loam::CompareOptions cmp_opt;
+  auto* compare =
+      app.add_subcommand("compare", "run a sweep of overrides; write compare.csv and pareto.png");
+  compare
+      ->add_option("sweep", cmp_opt.sweep_file,
+                   "sweep file (YAML: base, axes, set, metric, series)")
+      ->required();
+  compare->add_option("--out", cmp_opt.out_dir, "output directory (default results/<sweep name>)");
+  compare->add_option("--threads", cmp_opt.threads, "threads per variant")
+      ->check(CLI::Range(1, 1024));
+  compare->add_flag("--quiet", cmp_opt.quiet, "no progress lines");
 
   loam::BenchOptions bench_opt;
   auto* bench = app.add_subcommand("bench", "throughput benchmark on fixed scenes");
@@ -97,5 +110,6 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (*bench) return loam::run_bench(bench_opt);
+  if (*compare) return loam::run_compare(cmp_opt);
   return 0;
 }

@@ -15,6 +15,8 @@ Simulation<D>::~Simulation() = default;
 template <int D>
 Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag) : config(cfg) {
   threads = std::max(1, num_threads);
+  // Parallel loops without an explicit num_threads (e.g. in plugins) follow --threads too.
+  omp_set_num_threads(threads);
   build_grid(config.section("grid"), diag);
   if (!diag.ok()) return;
   const auto& g = config.vec("gravity");

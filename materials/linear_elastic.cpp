@@ -3,6 +3,7 @@
 // d = sym(L) dt, w = skew(L) dt. Tension positive. 2D is plane strain (sigma_zz from lambda tr d),
 // 1D is laterally confined (sigma_yy = sigma_zz = lambda tr d), as in VERIFICATION.md A.
 #include <cmath>
+#include <limits>
 
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
@@ -33,13 +34,13 @@ class LinearElastic : public Material<D> {
   double density() const override { return rho_; }
 
   double wave_speed(const Particles<D>& P, size_t b, size_t e) const override {
-    // c_p = sqrt(M / rho); rho grows as particles compress.
-    double rho_max = 0;
+    // c_p = sqrt(M / rho): fastest where the density is lowest (stretched particles).
+    double rho_min = std::numeric_limits<double>::infinity();
     const double* m = P.col(P.mass);
     const double* V = P.col(P.volume);
-#pragma omp parallel for reduction(max : rho_max) schedule(static)
-    for (size_t i = b; i < e; ++i) rho_max = std::max(rho_max, m[i] / V[i]);
-    return std::sqrt(M_ / std::max(rho_max, 1e-300));
+#pragma omp parallel for reduction(min : rho_min) schedule(static)
+    for (size_t i = b; i < e; ++i) rho_min = std::min(rho_min, m[i] / V[i]);
+    return std::sqrt(M_ / std::max(rho_min, 1e-300));
   }
 
   void update_stress(const MaterialBatch<D>& batch) override {

@@ -1,0 +1,94 @@
+// `loam compare`: every combination runs, failures are rows, finished variants are not re-run.
+#include <catch2/catch.hpp>
+#include <fstream>
+#include <sstream>
+
+#include "cli.hpp"
+
+using loam_test::run_loam;
+using loam_test::TempDir;
+
+namespace {
+
+std::vector<std::vector<std::string>> read_csv(const std::filesystem::path& p) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(p);
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells;
+    std::string cell;
+    bool quoted = false;
+    for (char c : line) {
+      if (c == '"')
+        quoted = !quoted;
+      else if (c == ',' && !quoted)
+        cells.push_back(cell), cell.clear();
+      else
+        cell += c;
+    }
+    cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+}  // namespace
+
+TEST_CASE("loam compare runs a sweep, records failures as rows and resumes", "[compare]") {
+  TempDir dir("compare");
+  std::filesystem::create_directories(dir.path);
+  const auto sweep = dir.path / "sweep.yaml";
+  std::ofstream(sweep) << "base: " << LOAM_SOURCE_DIR << "/configs/vibrating_bar.yaml\n"
+                       << "set: [time.end=30]\n"
+                       << "axes:\n"
+                       << "  grid.cell_size: [1.0, 0.5]\n"
+                       << "  time.dt: [0.01, 1.0]\n"  // 1.0 s is far above the CFL limit
+                       << "metric: period_error\nthreads: 1\n";
+  const auto out = dir.path / "out";
+  auto r = run_loam("compare " + sweep.string() + " --out " + out.string());
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  auto rows = read_csv(out / "compare.csv");
+  REQUIRE(rows.size() == 5);  // header + 2 x 2 variants
+  const auto& h = rows[0];
+  auto col = [&](const std::string& name) {
+    return size_t(std::find(h.begin(), h.end(), name) - h.begin());
+  };
+  for (const char* c : {"grid.cell_size", "time.dt", "status", "wall_seconds",
+                        "particle_steps_per_second", "period_error", "energy_drift", "message"})
+    CHECK(col(c) < h.size());
+  int ok = 0, unstable = 0;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    const auto& row = rows[i];
+    if (row[col("time.dt")] == "0.01") {
+      CHECK(row[col("status")] == "ok");
+      CHECK(std::stod(row[col("period_error")]) < 0.01);
+      ++ok;
+    } else {
+      CHECK(row[col("status")] == "unstable");
+      CHECK(row[col("message")].find("unstable run at step") != std::string::npos);
+      ++unstable;
+    }
+  }
+  CHECK(ok == 2);
+  CHECK(unstable == 2);
+  // Re-running skips every finished variant (ok and failed alike).
+  auto again = run_loam("compare " + sweep.string() + " --out " + out.string());
+  CHECK(again.exit_code == 0);
+  size_t skipped = 0;
+  for (size_t pos = 0; (pos = again.output.find("already done", pos)) != std::string::npos; ++pos)
+    ++skipped;
+  CHECK(skipped == 4);
+  CHECK(read_csv(out / "compare.csv").size() == 5);
+}
+
+TEST_CASE("loam compare rejects a bad sweep file with a located error", "[compare]") {
+  TempDir dir("compare_bad");
+  std::filesystem::create_directories(dir.path);
+  const auto sweep = dir.path / "sweep.yaml";
+  std::ofstream(sweep) << "base: nowhere.yaml\naxes:\n  grid.cell_size: 0.5\n";
+  auto r = run_loam("compare " + sweep.string() + " --out " + (dir.path / "out").string());
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find(sweep.string() + ":3:19: error: axes.grid.cell_size: expected a non-empty "
+                                       "list of values") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir.path / "out"));
+}

@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+"""Plot error against wall time from a `loam compare` CSV (log-log), one series per value of an
+axis (e.g. shape_function), with the Pareto front (no other variant both faster and more accurate)
+marked. Usage: pareto.py compare.csv --out pareto.png [--series AXIS] [--metric NAME]"""
+import argparse
+import csv
+import math
+import sys
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("csv")
+    ap.add_argument("--out", default="pareto.png")
+    ap.add_argument("--series", default="")
+    ap.add_argument("--metric", default="")
+    a = ap.parse_args()
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = list(csv.DictReader(open(a.csv)))
+    if not rows:
+        sys.exit("no rows in " + a.csv)
+    metric = a.metric or next((k for k in rows[0] if "error" in k), "")
+    if not metric or metric not in rows[0]:
+        sys.exit("no error metric column (use --metric)")
+    series = a.series if a.series in rows[0] else None
+    pts = []
+    for r in rows:
+        try:
+            t, e = float(r["wall_seconds"]), float(r[metric])
+        except (ValueError, KeyError):
+            continue  # failed variants have no numbers
+        if r["status"] == "ok" and t > 0 and e > 0 and math.isfinite(e):
+            pts.append((t, e, r[series] if series else "all", r["variant"]))
+    if not pts:
+        sys.exit("no successful variant with a positive error")
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for name in sorted({p[2] for p in pts}):
+        s = sorted((p for p in pts if p[2] == name), key=lambda p: p[0])
+        ax.plot([p[0] for p in s], [p[1] for p in s], "o-", label=name, alpha=0.8)
+    # Pareto front: sorted by time, keep points that improve on the best error so far.
+    front, best = [], float("inf")
+    for p in sorted(pts, key=lambda p: (p[0], p[1])):
+        if p[1] < best:
+            front.append(p)
+            best = p[1]
+    ax.plot([p[0] for p in front], [p[1] for p in front], "k--", lw=1, label="Pareto front")
+    ax.scatter([p[0] for p in front], [p[1] for p in front], s=120, facecolors="none",
+               edgecolors="k")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time per run (s)")
+    ax.set_ylabel(metric)
+    ax.set_title("speed against error" + (f" by {series}" if series else ""))
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(a.out, dpi=120)
+
+
+if __name__ == "__main__":
+    main()
