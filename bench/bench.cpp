@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "framework/config.hpp"
+#include "framework/registry.hpp"
 #include "framework/runner.hpp"
 
 namespace loam {
@@ -52,10 +53,22 @@ boundaries:
   return "";
 }
 
+int run_scene(const BenchOptions& opt, const std::string& scene, const std::string& shape);
+
 int run_bench(const BenchOptions& opt) {
   int status = 0;
-  for (const auto& scene : opt.scenes) {
-    std::string yaml = bench_scene(scene, opt.shape, opt.update);
+  std::vector<std::string> shapes = opt.shapes;
+  if (shapes.size() == 1 && shapes[0] == "all")
+    shapes = Registry::instance().names("shape_function");
+  for (const auto& shape : shapes)
+    for (const auto& scene : opt.scenes) status = std::max(status, run_scene(opt, scene, shape));
+  return status;
+}
+
+int run_scene(const BenchOptions& opt, const std::string& scene, const std::string& shape) {
+  int status = 0;
+  {
+    std::string yaml = bench_scene(scene, shape, opt.update);
     if (yaml.empty()) {
       std::fprintf(stderr,
                    "loam: error: unknown bench scene '%s' (elastic_block_2d, elastic_block_3d)\n",
@@ -117,7 +130,7 @@ int run_bench(const BenchOptions& opt) {
         std::printf(
             "%-18s %dD %-8s %-5s %zu particles, %ld steps, %d thread(s): %7.2f M particle-steps/s, "
             "%zu B/particle\n",
-            scene.c_str(), s["dimension"].get<int>(), opt.shape.c_str(), opt.update.c_str(),
+            scene.c_str(), s["dimension"].get<int>(), shape.c_str(), opt.update.c_str(),
             s["particles"].get<size_t>(), s["steps"].get<long>(), threads,
             s["particle_steps_per_second"].get<double>() / 1e6,
             s["bytes_per_particle"].get<size_t>());

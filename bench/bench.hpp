@@ -10,7 +10,7 @@ struct BenchOptions {
   std::vector<int> threads{1, 2};
   std::vector<std::string> scenes{"elastic_block_2d", "elastic_block_3d"};
   std::string update = "musl";
-  std::string shape = "linear";
+  std::vector<std::string> shapes{"linear"};  // "all": every registered shape function
   int repeat = 1;
   bool profile = false;
 };

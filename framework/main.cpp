@@ -66,7 +66,8 @@ int main(int argc, char** argv) {
   bench->add_option("--scenes", bench_opt.scenes,
                     "scenes (default: elastic_block_2d elastic_block_3d)");
   bench->add_option("--update", bench_opt.update, "musl, usl or usf");
-  bench->add_option("--shape-function", bench_opt.shape, "shape function");
+  bench->add_option("--shape-functions", bench_opt.shapes,
+                    "shape functions (default linear; all: every one)");
   bench->add_option("--repeat", bench_opt.repeat, "repeat each run and report the median")
       ->check(CLI::Range(1, 20));
   bench->add_flag("--profile", bench_opt.profile, "print where the step's time goes");

@@ -51,3 +51,22 @@ TEST_CASE("docs/plugins.md and docs/config.md are generated from the current sch
     CHECK(ss.str() == out);
   }
 }
+
+TEST_CASE("test names contain no semicolon (ctest would split them and run nothing)", "[layout]") {
+  int cases = 0;
+  for (const auto& e : fs::directory_iterator(fs::path(LOAM_SOURCE_DIR) / "tests")) {
+    if (e.path().extension() != ".cpp") continue;
+    std::ifstream in(e.path());
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string text = ss.str();
+    for (size_t pos = 0; (pos = text.find("TEST_CASE(\"", pos)) != std::string::npos; ++pos) {
+      const size_t end = text.find('"', pos + 11);
+      const std::string name = text.substr(pos + 11, end - pos - 11);
+      INFO(e.path().filename().string() << ": " << name);
+      CHECK(name.find(';') == std::string::npos);
+      ++cases;
+    }
+  }
+  CHECK(cases > 20);
+}

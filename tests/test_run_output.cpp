@@ -69,7 +69,7 @@ TEST_CASE("an unstable run stops with exit 3 naming step, time, particle and fie
   CHECK(failed_frame);
 }
 
-TEST_CASE("loam check validates without writing; plugins lists every kind", "[output]") {
+TEST_CASE("loam check validates without writing, plugins lists every kind", "[output]") {
   auto r = run_loam(std::string("check ") + LOAM_SOURCE_DIR + "/configs/elastic_column_3d.yaml");
   CHECK(r.exit_code == 0);
   CHECK(r.output.find("ok (3D, 5120 particles, 672 cells)") != std::string::npos);

@@ -80,7 +80,7 @@ TEST_CASE("deformation gradient, when requested, stays consistent with the volum
   CHECK(worst < 1e-12);
 }
 
-TEST_CASE("linear_elastic: uniaxial strain gives M eps; a rigid rotation keeps the invariants",
+TEST_CASE("linear_elastic: uniaxial strain gives M eps, a rigid rotation keeps the invariants",
           "[material][unit]") {
   auto sim = make_simulation<2>(block_2d("linear"));
   auto& P = sim->particles;
