@@ -153,9 +153,22 @@ bool apply_override(YAML::Node root, const std::string& arg, const std::string& 
         return false;
       }
       chain.push_back(cur[std::stoul(k)]);
-    } else {
+    } else if (cur.IsMap()) {
       if (!cur[k] || cur[k].IsNull()) cur[k] = YAML::Node(YAML::NodeType::Map);
+      // A plugin given by name alone (`shape_function: cpdi`) becomes {type: cpdi} so that
+      // its parameters can be overridden too.
+      if (cur[k].IsScalar()) {
+        YAML::Node m(YAML::NodeType::Map);
+        m["type"] = cur[k].Scalar();
+        cur[k] = m;
+      }
       chain.push_back(cur[k]);
+    } else {
+      diag.error(Location{label, 1, 1}, path,
+                 "cannot set '" + parts[i + 1] + "' inside '" +
+                     join({parts.begin(), parts.begin() + long(i) + 1}, ".") +
+                     "', which is not a map");
+      return false;
     }
   }
   YAML::Node parent = chain.back();

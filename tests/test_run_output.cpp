@@ -83,3 +83,15 @@ TEST_CASE("loam check validates without writing, plugins lists every kind", "[ou
   CHECK(bad.exit_code == 2);
   CHECK(bad.output.find("did you mean 'material'?") != std::string::npos);
 }
+
+TEST_CASE("--set can override a parameter of a plugin given by name only", "[output]") {
+  // `shape_function: linear` is shorthand for {type: linear}; `--set shape_function.key=...`
+  // used to abort inside yaml-cpp.
+  const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/vibrating_bar.yaml";
+  auto ok = run_loam("check " + cfg + " --set scheme=single_phase --set scheme.update=usl");
+  CHECK(ok.exit_code == 0);
+  auto bad = run_loam("check " + cfg + " --set shape_function=linear --set shape_function.foo=1");
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.output.find("<--set shape_function=linear>:1:1: error: shape_function.foo: unknown key "
+                        "'foo' (this takes no parameters)") != std::string::npos);
+}
