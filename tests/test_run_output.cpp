@@ -84,7 +84,7 @@ TEST_CASE("loam check validates without writing, plugins lists every kind", "[ou
   CHECK(bad.output.find("did you mean 'material'?") != std::string::npos);
 }
 
-TEST_CASE("--set can override a parameter of a plugin given by name only", "[output]") {
+TEST_CASE("a plugin given by name only can have its parameters overridden with --set", "[output]") {
   // `shape_function: linear` is shorthand for {type: linear}; `--set shape_function.key=...`
   // used to abort inside yaml-cpp.
   const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/vibrating_bar.yaml";
