@@ -296,7 +296,7 @@ time:
   require_rejected(s, r,
                    {s.error_at(4, 17, "shape_function",
                                "unknown shape_function 'lineer'; did you mean 'linear'? "
-                               "valid types are: linear")});
+                               "valid types are: bspline2, cpdi, gimp, linear")});
 }
 
 TEST_CASE("an unknown choice value suggests the closest one", "[bad_config]") {

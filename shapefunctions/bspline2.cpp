@@ -1,0 +1,125 @@
+// Quadratic B-splines on the uniform grid (Steffen, Kirby & Berzins 2008, IJNME 76 922-948), with
+// the boundary-modified functions of de Vaucorbeil, Nguyen, Sinaie & Wu 2020 ("Material point
+// method after 25 years", Adv. Appl. Mech. 53, section 3; also their code Karamelo), so that
+// partition of unity and linear reproduction hold up to the grid boundary without ghost nodes.
+//
+// Interior: the node-centred quadratic B-spline, with u = (x_p - x_I)/h,
+//   N(u) = 3/4 - u^2                 |u| < 1/2
+//        = (3/2 - |u|)^2 / 2         1/2 <= |u| < 3/2
+//        = 0                         otherwise,
+// C1 everywhere; its knots are at cell centres, so N is smooth across cell faces. A particle at
+// r = (x_p - x_b)/h in [-1/2, 1/2) from its nearest node b touches nodes b-1, b, b+1 (3^D entries)
+// with weights (r - 1/2)^2/2, 3/4 - r^2, (r + 1/2)^2/2 and gradients (r - 1/2)/h, -2r/h,
+// (r + 1/2)/h.
+//
+// Boundary: the missing ghost node -1 beyond boundary node 0 is eliminated by extrapolating it
+// linearly, N_0 <- N_0 + 2 N_-1 and N_1 <- N_1 - N_-1 (the constants and linear functions take
+// the values 1 = 2*1 - 1 and x_-1 = 2 x_0 - x_1 at the ghost, so both stay reproduced exactly);
+// likewise at the last node n: N_n <- N_n + 2 N_n+1, N_n-1 <- N_n-1 - N_n+1. This gives exactly
+// the modified functions of de Vaucorbeil et al. (2020), for the boundary node (x in [x_0, x_0 +
+// 3h/2), t = (x - x_0)/h)
+//   N_0 = 1 - t                      0 <= t < 1/2
+//       = (3/2 - t)^2 / 2            1/2 <= t < 3/2
+// and for its neighbour (t = (x - x_0)/h, x in [x_0, x_0 + 5h/2))
+//   N_1 = t                          0 <= t < 1/2
+//       = 3/4 - (t - 1)^2            1/2 <= t < 3/2
+//       = (5/2 - t)^2 / 2            3/2 <= t < 5/2,
+// all non-negative and C1. Half a cell next to the boundary the basis is the linear one.
+// Stencil entries whose node is outside the grid (the ghosts) carry the nearest valid node index
+// and zero weight and gradient.
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+
+namespace loam {
+
+template <int D>
+class BSpline2 : public ShapeFunction<D> {
+ public:
+  static constexpr const char* name = "bspline2";
+  static constexpr const char* summary =
+      "quadratic B-splines (3^D nodes, C1), boundary-modified so that partition of unity and "
+      "linear reproduction hold up to the grid boundary";
+  static Schema schema() { return Schema(); }
+  explicit BSpline2(const Params&) {}
+
+  int nodes_per_particle() const override { return ipow(3, D); }
+  // Nearest node b is r or r+1 for a particle in cell row r; nodes b-1 .. b+1.
+  int rows_below() const override { return 1; }
+  int rows_above() const override { return 2; }
+
+  void evaluate(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
+                StencilBlock<D>& out) const override {
+    constexpr int M = 3, K = ipow(3, D);
+    out.count = count;
+    // Per-axis weights first (vectorises across particles), then the tensor products,
+    // node-major so that each inner loop runs over contiguous particles.
+    alignas(64) double w[D][M][kBlock], dw[D][M][kBlock];
+    alignas(64) int32_t node[D][M][kBlock];
+    for (int d = 0; d < D; ++d) {
+      const double* x = P.col(P.position, d) + begin;
+      const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
+      const int n = g.cells[d];  // last node index along d
+      const int32_t stride = int32_t(g.node_stride[d]);
+      const double last = double(n);
+      alignas(64) double bd[kBlock];
+      for (int p = 0; p < count; ++p) {
+        const double xi = (x[p] - o) * ih;
+        int bi = int(xi + 0.5);  // nearest node, inside the grid
+        bi = bi < 0 ? 0 : bi;
+        bi = bi > n ? n : bi;
+        const double b = double(bi);
+        bd[p] = b;
+        const double r = xi - b;
+        const double w0 = 0.5 * (0.5 - r) * (0.5 - r), w1 = 0.75 - r * r,
+                     w2 = 0.5 * (0.5 + r) * (0.5 + r);
+        const double g0 = (r - 0.5) * ih, g1 = -2.0 * r * ih, g2 = (r + 0.5) * ih;
+        // Fold the ghost node (b-1 = -1 or b+1 = n+1) into its two inner neighbours. The flags
+        // lo = [b == 0] and hi = [b == n] are written as max(0, .) so that the loop vectorises.
+        const double l1 = 1.0 - b, h1 = b - (last - 1.0);
+        const double lo = l1 > 0.0 ? l1 : 0.0, hi = h1 > 0.0 ? h1 : 0.0;
+        const double wg = lo * w0 + hi * w2, gg = lo * g0 + hi * g2;
+        w[d][0][p] = w0 - wg;
+        w[d][1][p] = w1 + 2.0 * wg;
+        w[d][2][p] = w2 - wg;
+        dw[d][0][p] = g0 - gg;
+        dw[d][1][p] = g1 + 2.0 * gg;
+        dw[d][2][p] = g2 - gg;
+      }
+      for (int p = 0; p < count; ++p) {
+        const int b = int(bd[p]);
+        node[d][0][p] = (b > 0 ? b - 1 : 0) * stride;
+        node[d][1][p] = b * stride;
+        node[d][2][p] = (b < n ? b + 1 : n) * stride;
+      }
+    }
+    for (int k = 0; k < K; ++k) {
+      int j[D];
+      for (int d = 0, r = k; d < D; ++d, r /= M) j[d] = r % M;
+      int32_t* node_k = out.node.data() + size_t(k) * kBlock;
+      double* w_k = out.w.data() + size_t(k) * kBlock;
+      for (int p = 0; p < count; ++p) {
+        int32_t nk = 0;
+        double wp = 1.0;
+        for (int d = 0; d < D; ++d) {
+          nk += node[d][j[d]][p];
+          wp *= w[d][j[d]][p];
+        }
+        node_k[p] = nk;
+        w_k[p] = wp;
+      }
+      for (int d = 0; d < D; ++d) {
+        double* gr = out.grad.data() + (size_t(k) * D + size_t(d)) * kBlock;
+        for (int p = 0; p < count; ++p) {
+          double gp = dw[d][j[d]][p];
+          for (int e = 0; e < D; ++e)
+            if (e != d) gp *= w[e][j[e]][p];
+          gr[p] = gp;
+        }
+      }
+    }
+  }
+};
+
+LOAM_REGISTER(ShapeFunction, BSpline2)
+
+}  // namespace loam

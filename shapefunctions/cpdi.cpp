@@ -1,0 +1,375 @@
+// CPDI1: convected particle domain interpolation (Sadeghirad, Brannon & Burghardt 2011,
+// Int. J. Numer. Meth. Engng 86:1435-1456, "A convected particle domain interpolation technique
+// to extend applicability of the material point method for problems involving massive
+// deformations", section 3).
+//
+// Each particle carries a parallelogram (2D) / parallelepiped (3D) / segment (1D) domain
+//   x = x_p + R xi,  xi in [-1, 1]^D,   R = [r_1 ... r_D],   r_i = F r_i^0,
+// with r_i^0 = half the particle spacing of the particle's body along axis i (the domains of the
+// generated lattice tile the body) and F the deformation gradient that the scheme updates every
+// step. The 2^D corners are x_alpha = x_p + sum_i s_alpha,i r_i with sign vector s_alpha in
+// {-1, +1}^D. CPDI replaces the grid function N_I by its multilinear interpolation from the corner
+// values inside the domain and averages over the domain (paper, section 3):
+//
+//   weight    S_I      = (1/V_p) int N_I dV         = 2^-D sum_alpha N_I(x_alpha)
+//   gradient  grad S_I = (1/V_p) int grad N_I dV     = 2^-D R^-T sum_alpha s_alpha N_I(x_alpha)
+//
+// N_I is the linear (tent) function of grid node I. Derivation of the gradient in D dimensions:
+// the domain map is affine, so grad_x M_alpha = R^-T grad_xi M_alpha for the corner functions
+// M_alpha(xi) = prod_i (1 + s_alpha,i xi_i) / 2, and int_[-1,1]^D grad_xi M_alpha dxi = s_alpha;
+// with dV = det R dxi and V_p = 2^D det R, (1/V_p) int grad M_alpha dV = 2^-D R^-T s_alpha.
+// In 1D this is (N_I(x_p + r) - N_I(x_p - r)) / (2r). In 2D, with corners c1 = x_p - r1 - r2,
+// c2 = x_p + r1 - r2, c3 = x_p + r1 + r2, c4 = x_p - r1 + r2 and V_p = 4 (r1 x r2), it expands to
+// the paper's 2D gradient formula:
+//   grad S_I = (1/V_p) [ (N_I(c1) - N_I(c3)) (r1_y - r2_y, r2_x - r1_x)
+//                      + (N_I(c2) - N_I(c4)) (r1_y + r2_y, -r1_x - r2_x) ].
+// Partition of unity, sum_I grad S_I = 0 and exact reproduction of linear fields
+// (sum_I S_I x_I = x_p, sum_I x_I (x) grad S_I = R R^-1 = I) hold for any non-degenerate domain
+// inside the grid, because they hold for the tent functions at every corner.
+//
+// Stencil: the 2^D linear nodes of each corner's cell, entry k = alpha * 2^D + m, so 4^D entries;
+// node indices repeat when corners share a cell and the scatter/gather simply add them up.
+// begin_step() turns F into R once per step (field `cpdi_domain`), checks every domain (inverted
+// or degenerate, too stretched, corner outside the grid) and measures the largest domain extent
+// along the last axis for rows_below()/rows_above().
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+
+namespace loam {
+
+template <int D>
+class Cpdi : public ShapeFunction<D> {
+ public:
+  static constexpr const char* name = "cpdi";
+  static constexpr const char* summary =
+      "CPDI1: linear functions averaged over particle domains convected with F (4^D nodes)";
+  static Schema schema() {
+    Schema s;
+    s.real("max_stretch", "-",
+           "largest principal stretch of F (largest singular value) a particle domain may reach; "
+           "beyond it the domain spans many cells, its corners no longer represent the tent "
+           "functions inside it and the stencil reach grows, so the run stops with a message")
+        .def("4")
+        .above(1);
+    s.real("min_jacobian", "-",
+           "det F at or below which a domain counts as inverted or degenerate and the run stops")
+        .def("1e-3")
+        .above(0)
+        .below(1);
+    s.real("max_overhang", "-",
+           "how far a domain corner may lie outside the grid, as a fraction of the cell size, "
+           "before the run stops (tent functions are extrapolated from the boundary cell, which "
+           "keeps partition of unity and linear reproduction; the allowance absorbs the round-off "
+           "drift of corners of particles resting on a grid face)")
+        .def("0.1")
+        .non_negative()
+        .below(1);
+    return s;
+  }
+  explicit Cpdi(const Params& p)
+      : max_stretch_(p.real("max_stretch")),
+        min_jacobian_(p.real("min_jacobian")),
+        max_overhang_(p.real("max_overhang")) {}
+
+  int nodes_per_particle() const override { return 1 << (2 * D); }
+  int rows_below() const override { return reach_; }
+  int rows_above() const override { return reach_ + 1; }
+
+  void setup(Simulation<D>& sim, Diagnostics&) override {
+    auto& P = sim.particles;
+    F_ = P.request_deformation_gradient();
+    half_ = P.request({"cpdi_half_spacing", D, "m",
+                       "CPDI: initial domain half-size per axis, r_i^0 = spacing_i / 2",
+                       Particles<D>::axis_names()});
+    std::vector<std::string> names;
+    for (int d = 0; d < D; ++d)
+      for (int i = 0; i < D; ++i) names.push_back(std::string(1, "xyz"[d]) + "123"[i]);
+    R_ = P.request({"cpdi_domain", D * D, "m",
+                    "CPDI domain vectors R = F diag(r^0): component d*D + i is coordinate d of r_i",
+                    names});
+    for (size_t i = 0; i < P.size(); ++i)
+      for (int d = 0; d < D; ++d)
+        P.col(half_, d)[i] = 0.5 * sim.bodies[P.body[i]].spacing[size_t(d)];
+    std::string unused;
+    update_domains(sim, unused);  // R and the reach before the first sort
+  }
+
+  void begin_step(Simulation<D>& sim) override {
+    const int old_reach = reach_;
+    update_domains(sim, sim.failure);
+    // A larger reach may make the current slab colouring unsafe for this step's scatter.
+    if (reach_ > old_reach && sim.failure.empty() &&
+        !sim.partition.verify(sim.particles, sim.grid, rows_below(), rows_above()))
+      sim.sort();
+  }
+
+  void evaluate(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
+                StencilBlock<D>& out) const override {
+    constexpr int C = 1 << D;  // corners, and linear nodes per corner
+    out.count = count;
+    const double* x[D];
+    const double* r[D * D];
+    for (int d = 0; d < D; ++d) x[d] = P.col(P.position, d) + begin;
+    for (int c = 0; c < D * D; ++c) r[c] = P.col(R_, c) + begin;
+    // A = 2^-D R^-T per particle (the corner gradient factor), vectorised across particles.
+    alignas(64) double A[D * D][kBlock];
+    for (int p = 0; p < count; ++p) {
+      double m[D][D], a[D][D];
+      for (int d = 0; d < D; ++d)
+        for (int i = 0; i < D; ++i) m[d][i] = r[d * D + i][p];
+      inverse_transpose(m, a, 1.0 / C);
+      for (int d = 0; d < D; ++d)
+        for (int i = 0; i < D; ++i) A[d * D + i][p] = a[d][i];
+    }
+    // Corner by corner: per-axis tent weights of the corner's cell (as in linear.cpp), then the
+    // 2^D entries of that corner.
+    alignas(64) double n0[D][kBlock], n1[D][kBlock], G[D][kBlock];
+    alignas(64) int32_t base[kBlock];
+    for (int alpha = 0; alpha < C; ++alpha) {
+      for (int p = 0; p < count; ++p) base[p] = 0;
+      for (int d = 0; d < D; ++d) {
+        const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
+        const int last = g.cells[d] - 1;
+        const int32_t stride = int32_t(g.node_stride[d]);
+        for (int p = 0; p < count; ++p) {
+          double xc = x[d][p], gd = 0.0;
+          for (int i = 0; i < D; ++i) {
+            const double s = (alpha >> i) & 1 ? 1.0 : -1.0;
+            xc += s * r[d * D + i][p];
+            gd += s * A[d * D + i][p];
+          }
+          const double xi = (xc - o) * ih;
+          int c = int(xi);  // truncation: negative values are clamped to 0 below anyway
+          c = c < 0 ? 0 : (c > last ? last : c);  // outside: extrapolate the boundary cell
+          const double t = xi - c;
+          n0[d][p] = 1.0 - t;
+          n1[d][p] = t;
+          base[p] += c * stride;
+          G[d][p] = gd;  // grad S_I contribution of this corner = G * N_I(x_alpha)
+        }
+      }
+      for (int m = 0; m < C; ++m) {
+        const int k = alpha * C + m;
+        int32_t offset = 0;
+        for (int d = 0; d < D; ++d) offset += (m >> d) & 1 ? int32_t(g.node_stride[d]) : 0;
+        int32_t* node = out.node.data() + size_t(k) * kBlock;
+        double* w = out.w.data() + size_t(k) * kBlock;
+        alignas(64) double N[kBlock];
+        for (int p = 0; p < count; ++p) {
+          node[p] = base[p] + offset;
+          double np = 1.0;
+          for (int d = 0; d < D; ++d) np *= (m >> d) & 1 ? n1[d][p] : n0[d][p];
+          N[p] = np;
+          w[p] = np * (1.0 / C);
+        }
+        for (int d = 0; d < D; ++d) {
+          double* gr = out.grad.data() + (size_t(k) * D + size_t(d)) * kBlock;
+          for (int p = 0; p < count; ++p) gr[p] = G[d][p] * N[p];
+        }
+      }
+    }
+  }
+
+ private:
+  double max_stretch_, min_jacobian_, max_overhang_;
+  int F_ = -1, half_ = -1, R_ = -1;
+  int reach_ = 1;
+  static constexpr size_t kParallelMin =
+      4096;  // fewer particles: not worth a fork/join  // rows a corner's cell can lie from the
+             // particle's cell along the last axis
+
+  static double det(const double (&m)[D][D]) {
+    if constexpr (D == 1) {
+      return m[0][0];
+    } else if constexpr (D == 2) {
+      return m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    } else {
+      return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+             m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+             m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    }
+  }
+
+  /// a = scale * m^-T = scale * cof(m) / det(m).
+  static void inverse_transpose(const double (&m)[D][D], double (&a)[D][D], double scale) {
+    const double f = scale / det(m);
+    if constexpr (D == 1) {
+      a[0][0] = f;
+    } else if constexpr (D == 2) {
+      a[0][0] = f * m[1][1], a[0][1] = -f * m[1][0];
+      a[1][0] = -f * m[0][1], a[1][1] = f * m[0][0];
+    } else {
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          const int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+          a[i][j] = f * (m[i1][j1] * m[i2][j2] - m[i1][j2] * m[i2][j1]);
+        }
+    }
+  }
+
+  /// Largest singular value of F (exact; only called when |F|_Frobenius exceeds max_stretch).
+  static double largest_stretch(const double (&f)[D][D]) {
+    double c[D][D] = {};  // C = F^T F
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j)
+        for (int k = 0; k < D; ++k) c[i][j] += f[k][i] * f[k][j];
+    if constexpr (D == 1) {
+      return std::sqrt(c[0][0]);
+    } else if constexpr (D == 2) {
+      const double h = 0.5 * (c[0][0] + c[1][1]), q = 0.5 * (c[0][0] - c[1][1]);
+      return std::sqrt(h + std::sqrt(q * q + c[0][1] * c[0][1]));
+    } else {
+      // Largest eigenvalue of the symmetric C, trigonometric form (Smith 1961).
+      const double p1 = c[0][1] * c[0][1] + c[0][2] * c[0][2] + c[1][2] * c[1][2];
+      const double q = (c[0][0] + c[1][1] + c[2][2]) / 3.0;
+      const double p2 = (c[0][0] - q) * (c[0][0] - q) + (c[1][1] - q) * (c[1][1] - q) +
+                        (c[2][2] - q) * (c[2][2] - q) + 2.0 * p1;
+      const double p = std::sqrt(p2 / 6.0);
+      if (p == 0.0) return std::sqrt(q);
+      double b[3][3];
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) b[i][j] = (c[i][j] - (i == j ? q : 0.0)) / p;
+      const double hr = std::clamp(0.5 * det(b), -1.0, 1.0);
+      return std::sqrt(q + 2.0 * p * std::cos(std::acos(hr) / 3.0));
+    }
+  }
+
+  /// R = F diag(r^0) for every particle, the checks, and the reach. Writes a message naming the
+  /// first bad particle into `failure` (left untouched when all domains are fine).
+  void update_domains(Simulation<D>& sim, std::string& failure) {
+    auto& P = sim.particles;
+    const auto& g = sim.grid;
+    const size_t n = P.size();
+    const double* Fc[D * D];
+    double* Rc[D * D];
+    const double *h0[D], *x[D];
+    for (int c = 0; c < D * D; ++c) Fc[c] = P.col(F_, c), Rc[c] = P.col(R_, c);
+    for (int d = 0; d < D; ++d) h0[d] = P.col(half_, d), x[d] = P.col(P.position, d);
+    double lo[D], hi[D];
+    for (int d = 0; d < D; ++d) {
+      const double slack = max_overhang_ * g.cell[size_t(d)];
+      lo[d] = g.origin[size_t(d)] - slack;
+      hi[d] = g.upper(d) + slack;
+    }
+    const double s2 = max_stretch_ * max_stretch_, jmin = min_jacobian_;
+    double max_extent = 0;  // along the last axis
+    size_t suspect = n;     // first particle failing a cheap (sufficient) test
+#pragma omp parallel for schedule(static) num_threads(sim.threads) if (n >= kParallelMin) \
+    reduction(max                                                                         \
+              : max_extent) reduction(min                                                 \
+                                      : suspect)
+    for (size_t i = 0; i < n; ++i) {
+      double f[D][D], frob2 = 0;
+      for (int d = 0; d < D; ++d)
+        for (int j = 0; j < D; ++j) {
+          f[d][j] = Fc[d * D + j][i];
+          frob2 += f[d][j] * f[d][j];
+          Rc[d * D + j][i] = f[d][j] * h0[j][i];
+        }
+      bool ok = det(f) > jmin && frob2 <= s2;  // sigma_max(F) <= |F|_Frobenius
+      for (int d = 0; d < D; ++d) {
+        double e = 0;  // half-extent of the domain's bounding box along d
+        for (int j = 0; j < D; ++j) e += std::fabs(f[d][j] * h0[j][i]);
+        ok = ok && x[d][i] - e >= lo[d] && x[d][i] + e <= hi[d];
+        if (d == D - 1) max_extent = std::max(max_extent, e);
+      }
+      if (!ok) suspect = std::min(suspect, i);
+    }
+    // Rows: a corner lies within max_extent of the particle along the last axis, so its cell row
+    // differs from the particle's by at most floor(max_extent / h) + 1 (one more than ceil when
+    // the ratio is an integer, against round-off); its tent functions reach one row further up.
+    reach_ = int(std::floor(max_extent * g.inv_cell[D - 1])) + 1;
+    if (suspect == n) return;
+    // Exact checks from the first suspect on (the Frobenius test is only sufficient).
+    size_t bad = n;
+#pragma omp parallel for schedule(static)                                   \
+    num_threads(sim.threads) if (n - suspect >= kParallelMin) reduction(min \
+                                                                        : bad)
+    for (size_t i = suspect; i < n; ++i) {
+      int axis = 0;
+      if (check(sim, i, axis) != Problem::kNone) bad = std::min(bad, i);
+    }
+    if (bad < n) failure = message(sim, bad);
+  }
+
+  static std::string num(double v) {  // 6 significant digits are enough for a message
+    char b[32];
+    std::snprintf(b, sizeof b, "%.6g", v);
+    return b;
+  }
+
+  enum class Problem { kNone, kInverted, kStretched, kOutside };
+
+  /// Exact check of particle i's domain; `axis` is set for kOutside.
+  Problem check(const Simulation<D>& sim, size_t i, int& axis) const {
+    const auto& P = sim.particles;
+    const auto& g = sim.grid;
+    double f[D][D];
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) f[d][j] = P.col(F_, d * D + j)[i];
+    if (!(det(f) > min_jacobian_)) return Problem::kInverted;
+    if (!(largest_stretch(f) <= max_stretch_)) return Problem::kStretched;
+    for (int d = 0; d < D; ++d) {
+      double e = 0;
+      for (int j = 0; j < D; ++j) e += std::fabs(f[d][j] * P.col(half_, j)[i]);
+      const double xp = P.col(P.position, d)[i], slack = max_overhang_ * g.cell[size_t(d)];
+      if (g.origin[size_t(d)] - (xp - e) > slack || xp + e - g.upper(d) > slack) {
+        axis = d;
+        return Problem::kOutside;
+      }
+    }
+    return Problem::kNone;
+  }
+
+  /// The message for a particle whose check failed.
+  std::string message(const Simulation<D>& sim, size_t i) const {
+    const auto& P = sim.particles;
+    const auto& g = sim.grid;
+    int d = 0;
+    const Problem what = check(sim, i, d);
+    double f[D][D];
+    for (int a = 0; a < D; ++a)
+      for (int j = 0; j < D; ++j) f[a][j] = P.col(F_, a * D + j)[i];
+    std::ostringstream s;
+    s << "particle " << P.id[i] << " of body '" << sim.bodies[P.body[i]].name << "' at (";
+    for (int a = 0; a < D; ++a) s << (a ? ", " : "") << num(P.col(P.position, a)[i]);
+    s << "): ";
+    const char* other =
+        "a shape function without deforming particle domains (e.g. linear or bspline2)";
+    if (what == Problem::kInverted) {
+      s << "CPDI domain inverted or degenerate (det F = " << num(det(f))
+        << " <= min_jacobian = " << num(min_jacobian_)
+        << "); remedy: a smaller time step (time.cfl), a finer grid, or " << other;
+    } else if (what == Problem::kStretched) {
+      s << "CPDI domain too distorted (largest principal stretch of F " << num(largest_stretch(f))
+        << " > max_stretch = " << num(max_stretch_)
+        << "); remedy: a smaller time step (time.cfl) if the deformation is spurious, a larger "
+           "shape_function.max_stretch (less accurate: CPDI1 samples the tent functions only at "
+           "the corners of a domain that then spans more cells), or "
+        << other;
+    } else {
+      double e = 0;
+      for (int j = 0; j < D; ++j) e += std::fabs(f[d][j] * P.col(half_, j)[i]);
+      const double xp = P.col(P.position, d)[i];
+      s << "CPDI domain corner leaves the grid along "
+        << "xyz"[d] << " (domain spans " << num(xp - e) << " to " << num(xp + e) << " m, grid "
+        << num(g.origin[size_t(d)]) << " to " << num(g.upper(d)) << " m, allowed overhang "
+        << num(max_overhang_ * g.cell[size_t(d)])
+        << " m); remedy: extend the grid (grid.origin, grid.extent) beyond the material, a "
+           "smaller time step (time.cfl), or "
+        << other;
+    }
+    return s.str();
+  }
+};
+
+LOAM_REGISTER(ShapeFunction, Cpdi)
+
+}  // namespace loam

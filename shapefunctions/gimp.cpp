@@ -1,0 +1,297 @@
+// Uniform GIMP (generalized interpolation material point; Bardenhagen & Kober 2004, CMES 5(6)
+// 477-495, the "uGIMP" of Wallstedt & Guilkey 2008, JCP 227 9628-9642). The weight of node I is
+// the linear hat N_I averaged over the particle's domain, a box of half-width lp_d per axis:
+//   S_I(x_p) = prod_d S(x_pd - x_Id; lp_d, h_d),  S(xi) = 1/(2 lp) int_{xi-lp}^{xi+lp} N(s) ds.
+// For lp <= h/2 this is the standard piecewise quadratic of Bardenhagen & Kober (2004):
+//   S(xi) = 1 - (xi^2 + lp^2) / (2 h lp)        |xi| < lp
+//         = 1 - |xi| / h                        lp <= |xi| < h - lp
+//         = (h + lp - |xi|)^2 / (4 h lp)        h - lp <= |xi| < h + lp
+//         = 0                                   otherwise
+//  dS/dx_p = -xi / (h lp), -sign(xi) / h, -sign(xi) (h + lp - |xi|) / (2 h lp), 0.
+// It is evaluated here in an equivalent form that has no branches and no cancellation, and is
+// valid for any lp (so also for the stretched domains below): with u = xi/h and a = lp/h, the
+// hat's average is the hat plus the smoothing of its three kinks (slopes change by +1, -2, +1 at
+// u = -1, 0, 1), each kink contributing E(t) = max(0, a - |t|)^2 / (4a):
+//   S = hat(u) + E(u + 1) - 2 E(u) + E(u - 1),      hat(u) = max(0, 1 - |u|),
+//   dS/dx_p = (hat(u + a) - hat(u - a)) / (2 lp).
+// On the 3-node stencil (lp <= h/2, nearest node b, r = (x_p - x_b)/h) only E(r) survives:
+//   S_b+1 = max(r, 0) + E(r),  S_b-1 = max(-r, 0) + E(r),  S_b = 1 - S_b-1 - S_b+1.
+// The weights are C1 in x_p: the gradient is continuous across cell faces, which removes the
+// cell-crossing noise of linear shape functions.
+//
+// lp_d is half the particle spacing of the particle's body (h_d / (2 particles_per_cell)), stored
+// per particle in the field `gimp_half_width` at set-up. A node is non-zero only if
+// |xi| < h + lp, so lp <= h/2 needs the 3 nodes per axis nearest the particle (3^D entries).
+//
+// domain_update: stretch (contiguous-GIMP-like; cf. cpGIMP in Uintah, Wallstedt & Guilkey 2008)
+// sets lp_d = lp0_d F_dd every step from the deformation gradient F (requested from the scheme).
+// Only the stretch along the axes is followed: shear and rotation of the domain are ignored (use
+// cpdi for those). A stretched domain may reach lp = h, so the stencil is 4 nodes per axis
+// (4^D entries); a longer domain is capped at lp = h (a warning reports how many), and
+// F_dd <= 0 (an inverted domain) stops the run.
+//
+// Grid boundary: nodes outside the grid get a valid node index and zero weight and gradient. A
+// particle whose domain lies inside the grid keeps partition of unity and linear reproduction
+// exactly; if its domain crosses the grid boundary, the part of the domain outside is lost:
+// sum N = 1 - (weight of the missing nodes), e.g. 1 - lp/(4h) for a particle centred on the
+// boundary, and sum grad N != 0. Particles are generated with their domains inside the grid, so
+// this happens only when material reaches the outermost half-domain of the grid.
+#include <spdlog/spdlog.h>
+
+#include <array>
+#include <cmath>
+
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+
+namespace loam {
+
+namespace {
+
+/// Per-axis weights, gradients and node offsets (node coordinate times stride) of M nodes for a
+/// block of particles, and their tensor product into the stencil, node-major.
+template <int D, int M>
+struct GimpAxes {
+  alignas(64) double w[D][M][kBlock];
+  alignas(64) double dw[D][M][kBlock];
+  alignas(64) int32_t node[D][M][kBlock];
+
+  void tensor_product(int count, StencilBlock<D>& out) const {
+    constexpr int K = ipow(M, D);
+    for (int k = 0; k < K; ++k) {
+      int j[D];
+      for (int d = 0, r = k; d < D; ++d, r /= M) j[d] = r % M;
+      int32_t* node_k = out.node.data() + size_t(k) * kBlock;
+      double* w_k = out.w.data() + size_t(k) * kBlock;
+      for (int p = 0; p < count; ++p) {
+        int32_t n = 0;
+        double wp = 1.0;
+        for (int d = 0; d < D; ++d) {
+          n += node[d][j[d]][p];
+          wp *= w[d][j[d]][p];
+        }
+        node_k[p] = n;
+        w_k[p] = wp;
+      }
+      for (int d = 0; d < D; ++d) {
+        double* gr = out.grad.data() + (size_t(k) * D + size_t(d)) * kBlock;
+        for (int p = 0; p < count; ++p) {
+          double gp = dw[d][j[d]][p];
+          for (int e = 0; e < D; ++e)
+            if (e != d) gp *= w[e][j[e]][p];
+          gr[p] = gp;
+        }
+      }
+    }
+  }
+};
+
+}  // namespace
+
+template <int D>
+class Gimp : public ShapeFunction<D> {
+ public:
+  static constexpr const char* name = "gimp";
+  static constexpr const char* summary =
+      "uniform GIMP (Bardenhagen & Kober 2004): hat functions averaged over a particle domain of "
+      "half the particle spacing; 3^D nodes (4^D with domain stretch), C1 across cell faces";
+  static Schema schema() {
+    Schema s;
+    s.choice("domain_update", {"none", "stretch"},
+             "particle domain in time: none (uGIMP: fixed half-width lp0 = half the particle "
+             "spacing of the body) or stretch (lp_d = lp0_d F_dd from the deformation gradient, "
+             "contiguous-GIMP-like; 4^D nodes, lp capped at one cell with a warning, stops if "
+             "F_dd <= 0)")
+        .def("none");
+    return s;
+  }
+  explicit Gimp(const Params& p) : stretch_(p.text("domain_update") == "stretch") {}
+
+  int nodes_per_particle() const override { return ipow(stretch_ ? 4 : 3, D); }
+  // A particle in cell row r reaches node rows r-1 .. r+2: its nearest node (r or r+1) +-1 with
+  // 3 nodes per axis, nodes r-1 .. r+2 with 4.
+  int rows_below() const override { return 1; }
+  int rows_above() const override { return 2; }
+
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    Particles<D>& P = sim.particles;
+    half_width_ = P.request(
+        {"gimp_half_width", D, "m", "GIMP particle-domain half-width lp per axis", P.axis_names()});
+    if (stretch_) {
+      half_width0_ =
+          P.request({"gimp_half_width0", D, "m", "initial GIMP particle-domain half-width per axis",
+                     P.axis_names()});
+      deformation_gradient_ = P.request_deformation_gradient();
+    }
+    for (int d = 0; d < D; ++d) {
+      double* lp = P.col(half_width_, d);
+      double* lp0 = stretch_ ? P.col(half_width0_, d) : nullptr;
+      const double h = sim.grid.cell[size_t(d)];
+      for (size_t i = 0; i < P.size(); ++i) {
+        lp[i] = 0.5 * sim.bodies[P.body[i]].spacing[size_t(d)];
+        if (lp0) lp0[i] = lp[i];
+        if (!stretch_ && lp[i] > 0.5 * h * (1 + 1e-12)) {
+          diag.error(sim.config.where("shape_function"), "shape_function",
+                     "gimp: body '" + sim.bodies[P.body[i]].name +
+                         "' has a particle spacing larger than the cell size; uGIMP needs at "
+                         "least one particle per cell");
+          return;
+        }
+      }
+    }
+  }
+
+  void begin_step(Simulation<D>& sim) override {
+    if (!stretch_) return;
+    Particles<D>& P = sim.particles;
+    const long n = long(P.size());
+    long first_bad = n, first_capped = n, capped = 0;
+    std::array<const double*, D> F{}, lp0{};
+    std::array<double*, D> lp{};
+    std::array<double, D> h{};
+    for (int d = 0; d < D; ++d) {
+      F[size_t(d)] = P.col(deformation_gradient_, d * D + d);
+      lp0[size_t(d)] = P.col(half_width0_, d);
+      lp[size_t(d)] = P.col(half_width_, d);
+      h[size_t(d)] = sim.grid.cell[size_t(d)];
+    }
+#pragma omp parallel for schedule(static) num_threads(sim.threads) \
+    reduction(min : first_bad, first_capped) reduction(+ : capped)
+    for (long i = 0; i < n; ++i)
+      for (size_t d = 0; d < size_t(D); ++d) {
+        const double f = F[d][i];
+        if (!(f > 0)) first_bad = std::min(first_bad, i);
+        double l = lp0[d][i] * f;
+        if (l > h[d]) {
+          l = h[d];
+          ++capped;
+          first_capped = std::min(first_capped, i);
+        }
+        lp[d][i] = l;
+      }
+    if (first_bad < n) {
+      const size_t i = size_t(first_bad);
+      int d = 0;
+      while (d + 1 < D && F[size_t(d)][i] > 0) ++d;
+      sim.failure = "particle " + std::to_string(P.id[i]) + " (body " + sim.bodies[P.body[i]].name +
+                    "): GIMP domain inverted, F_" + std::string(2, "xyz"[d]) + " = " +
+                    format_number(F[size_t(d)][i]) +
+                    " <= 0 (shape_function.domain_update: stretch)";
+      return;
+    }
+    if (capped > 0 && !warned_) {
+      warned_ = true;
+      const size_t i = size_t(first_capped);
+      spdlog::warn(
+          "gimp: particle domains stretched beyond one cell are capped at lp = h: {} half-widths "
+          "at step {} (first: particle {}, body {}); the stencil cannot follow a longer domain "
+          "(warned once)",
+          capped, sim.step, P.id[i], sim.bodies[P.body[i]].name);
+    }
+  }
+
+  void evaluate(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
+                StencilBlock<D>& out) const override {
+    if (stretch_)
+      evaluate_m<4>(g, P, begin, count, out);
+    else
+      evaluate_m<3>(g, P, begin, count, out);
+  }
+
+ private:
+  bool stretch_;
+  bool warned_ = false;
+  // max(v, 0) and clamp(v, 0, 1) (v an integer) in arithmetic: exact, and unlike a select they
+  // are never sunk into branches that stop the loop from vectorising.
+  static double pos(double v) {
+    return 0.5 * (v + std::fabs(v));
+  }
+  static double unit(double v) {
+    return pos(v) - pos(v - 1.0);
+  }
+  int half_width_ = -1, half_width0_ = -1, deformation_gradient_ = -1;
+
+  /// M = 3: the nearest node and its neighbours; M = 4: nodes c-1 .. c+2 of cell c.
+  template <int M>
+  void evaluate_m(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
+                  StencilBlock<D>& out) const {
+    out.count = count;
+    GimpAxes<D, M> ax;
+    for (int d = 0; d < D; ++d) {
+      const double* x = P.col(P.position, d) + begin;
+      const double* lp = P.col(half_width_, d) + begin;
+      const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
+      const int n = g.cells[d];  // last node index along d
+      const int32_t stride = int32_t(g.node_stride[d]);
+      const double last = double(n);
+      alignas(64) int32_t first[kBlock];
+      // First stencil node, then the weights in branch-free double arithmetic (a loop of its
+      // own, so that it vectorises), then the node indices.
+      for (int p = 0; p < count; ++p) {
+        const double xi = (x[p] - o) * ih;
+        int c;
+        if constexpr (M == 3) {
+          c = int(xi + 0.5);  // nearest node
+          c = c < 0 ? 0 : (c > n ? n : c);
+        } else {
+          c = int(xi);  // cell, inside the grid
+          c = c < 0 ? 0 : (c > n - 1 ? n - 1 : c);
+        }
+        first[p] = c - 1;
+      }
+      if constexpr (M == 3) {
+        // lp <= h/2, nearest node b, r = (x_p - x_b)/h in [-1/2, 1/2]: of the kink terms only
+        // E(r) is non-zero, so S_b+1 = max(r, 0) + E(r), S_b-1 = max(-r, 0) + E(r) and
+        // S_b = 1 - S_b-1 - S_b+1 (= 1 - |r| - 2 E(r)); the same for the gradients.
+        for (int p = 0; p < count; ++p) {
+          const double xi = (x[p] - o) * ih;
+          const double b = double(first[p] + 1);
+          const double r = xi - b;
+          const double a = lp[p] * ih;  // half-width in cells
+          const double gs = 0.5 / a * ih, e = pos(a - std::fabs(r)), E = e * e * (0.25 / a);
+          const double wp = pos(r) + E, wm = pos(-r) + E;
+          const double gp = (pos(r + a) - pos(r - a)) * gs, gm = (pos(-r - a) - pos(a - r)) * gs;
+          const double in_lo = unit(b), in_hi = unit(last - b);  // node b-1, b+1 in the grid
+          ax.w[d][0][p] = in_lo * wm;
+          ax.w[d][1][p] = 1.0 - wp - wm;
+          ax.w[d][2][p] = in_hi * wp;
+          ax.dw[d][0][p] = in_lo * gm;
+          ax.dw[d][1][p] = -(gp + gm);
+          ax.dw[d][2][p] = in_hi * gp;
+        }
+      } else {
+        for (int p = 0; p < count; ++p) {
+          const double xi = (x[p] - o) * ih;
+          const double i0 = double(first[p]);
+          const double a = lp[p] * ih;  // half-width in cells
+          const double inv4a = 0.25 / a, grad_scale = 0.5 / a * ih;
+          for (int j = 0; j < M; ++j) {
+            const double i = i0 + j;
+            const double u = xi - i;
+            const double e0 = pos(a - std::fabs(u)), em = pos(a - std::fabs(u + 1.0)),
+                         ep = pos(a - std::fabs(u - 1.0));
+            const double s = pos(1.0 - std::fabs(u)) + (em * em - 2.0 * e0 * e0 + ep * ep) * inv4a;
+            const double ds =
+                (pos(1.0 - std::fabs(u + a)) - pos(1.0 - std::fabs(u - a))) * grad_scale;
+            // 1 for nodes 0 <= i <= n, 0 outside the grid (i is an integer).
+            const double inside = unit(i + 1.0) * unit(last + 1.0 - i);
+            ax.w[d][j][p] = inside * s;
+            ax.dw[d][j][p] = inside * ds;
+          }
+        }
+      }
+      for (int p = 0; p < count; ++p) {
+        const int i0 = first[p];
+        for (int j = 0; j < M; ++j) {
+          const int i = i0 + j;
+          ax.node[d][j][p] = (i < 0 ? 0 : (i > n ? n : i)) * stride;
+        }
+      }
+    }
+    ax.tensor_product(count, out);
+  }
+};
+
+LOAM_REGISTER(ShapeFunction, Gimp)
+
+}  // namespace loam

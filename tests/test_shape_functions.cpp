@@ -1,0 +1,572 @@
+// Unit tests of the gimp and bspline2 shape functions in 1D, 2D and 3D (issue 4): partition of
+// unity, zero gradient sum, linear reproduction, gradient continuity across cell faces (linear as
+// the contrast), weights at and near the grid boundary, GIMP domains straddling a cell face and
+// stretched with F; and the vibrating bar through the CLI with each shape function.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <map>
+#include <random>
+#include <string>
+
+#include "cli.hpp"
+#include "sim_helpers.hpp"
+
+using loam_test::make_simulation;
+
+namespace {
+
+// A unit square/cube (1 m, 10 cells per axis) with a block of particles, 2 per cell: GIMP
+// half-width lp = h/4 = 0.025 m.
+template <int D>
+std::string scene(const std::string& shape, int ppc = 2) {
+  auto vec = [](double v) {
+    std::string s = "[";
+    for (int d = 0; d < D; ++d) s += (d ? ", " : "") + std::to_string(v);
+    return s + "]";
+  };
+  return "grid: {extent: " + vec(1.0) + ", cell_size: 0.1}\nshape_function: " + shape +
+         "\nbodies:\n  - name: b\n    generator: {type: box, min: " + vec(0.2) +
+         ", max: " + vec(0.8) + "}\n    particles_per_cell: " + std::to_string(ppc) +
+         "\n    material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 1000}\n"
+         "time: {end: 1}\n";
+}
+
+/// Weight and gradient per node of one particle, summed over stencil entries (entries for nodes
+/// outside the grid map to a valid node with zero weight, so summing is exact).
+template <int D>
+using NodeValues = std::map<int32_t, std::array<double, D + 1>>;
+
+template <int D>
+NodeValues<D> evaluate_at(loam::Simulation<D>& sim, const std::array<double, D>& x,
+                          size_t particle = 0) {
+  auto& P = sim.particles;
+  for (int d = 0; d < D; ++d) P.col(P.position, d)[particle] = x[size_t(d)];
+  loam::StencilBlock<D> st;
+  st.allocate(sim.shape->nodes_per_particle());
+  sim.shape->evaluate(sim.grid, P, particle, 1, st);
+  NodeValues<D> out;
+  for (int k = 0; k < st.npp; ++k) {
+    const size_t kp = size_t(k) * loam::kBlock;
+    REQUIRE(st.node[kp] >= 0);
+    REQUIRE(size_t(st.node[kp]) < sim.grid.num_nodes);
+    auto& v = out[st.node[kp]];
+    v[0] += st.w[kp];
+    for (int d = 0; d < D; ++d)
+      v[size_t(d + 1)] += st.grad[(size_t(k) * D + size_t(d)) * loam::kBlock];
+  }
+  return out;
+}
+
+struct Errors {
+  double sum = 0, grad = 0, repro = 0, grad_repro = 0, rows = 0;
+};
+
+/// Evaluate every particle (in full blocks) and measure the consistency errors: |sum N - 1|,
+/// h |sum grad N|, |sum N x_I - x_p| / h, |sum x_I (x) grad N - I|, and stencil entries outside
+/// the node rows [r - rows_below, r + rows_above] (must be 0).
+template <int D>
+Errors consistency(loam::Simulation<D>& sim) {
+  auto& P = sim.particles;
+  const auto& g = sim.grid;
+  loam::StencilBlock<D> st;
+  st.allocate(sim.shape->nodes_per_particle());
+  Errors e;
+  for (size_t b = 0; b < P.size(); b += loam::kBlock) {
+    const int count = int(std::min<size_t>(loam::kBlock, P.size() - b));
+    sim.shape->evaluate(g, P, b, count, st);
+    for (int p = 0; p < count; ++p) {
+      double sum = 0, gsum[D] = {}, xr[D] = {}, gx[D][D] = {};
+      const int row = g.cell_of(P.col(P.position, D - 1)[b + size_t(p)], D - 1);
+      for (int k = 0; k < st.npp; ++k) {
+        const size_t kp = size_t(k) * loam::kBlock + size_t(p);
+        const int node_row = g.node_ijk(size_t(st.node[kp]))[D - 1];
+        if (node_row < row - sim.shape->rows_below() || node_row > row + sim.shape->rows_above())
+          e.rows += 1;
+        sum += st.w[kp];
+        for (int i = 0; i < D; ++i) {
+          const double xi = g.node_coord(size_t(st.node[kp]), i);
+          xr[i] += st.w[kp] * xi;
+          for (int j = 0; j < D; ++j)
+            gx[i][j] += xi * st.grad[(size_t(k) * D + size_t(j)) * loam::kBlock + size_t(p)];
+        }
+        for (int j = 0; j < D; ++j)
+          gsum[j] += st.grad[(size_t(k) * D + size_t(j)) * loam::kBlock + size_t(p)];
+      }
+      e.sum = std::max(e.sum, std::fabs(sum - 1));
+      for (int i = 0; i < D; ++i) {
+        e.grad = std::max(e.grad, std::fabs(gsum[i]) * g.cell[size_t(i)]);
+        e.repro = std::max(
+            e.repro, std::fabs(xr[i] - P.col(P.position, i)[b + size_t(p)]) / g.cell[size_t(i)]);
+        for (int j = 0; j < D; ++j)
+          e.grad_repro = std::max(e.grad_repro, std::fabs(gx[i][j] - (i == j ? 1.0 : 0.0)));
+      }
+    }
+  }
+  return e;
+}
+
+/// Place every particle at a random position in [lo, hi]^D and check the consistency errors.
+template <int D>
+void check_random_consistency(const std::string& shape, double lo, double hi,
+                              const std::string& label, unsigned seed = 11) {
+  auto sim = make_simulation<D>(scene<D>(shape));
+  auto& P = sim->particles;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(lo, hi);
+  // At least ~1500 random positions per dimension (the 1D block has only 12 particles).
+  const int rounds = int(1500 / P.size()) + 1;
+  Errors e;
+  for (int round = 0; round < rounds; ++round) {
+    for (size_t i = 0; i < P.size(); ++i)
+      for (int d = 0; d < D; ++d) P.col(P.position, d)[i] = u(rng);
+    const Errors r = consistency(*sim);
+    e.sum = std::max(e.sum, r.sum), e.grad = std::max(e.grad, r.grad);
+    e.repro = std::max(e.repro, r.repro), e.grad_repro = std::max(e.grad_repro, r.grad_repro);
+    e.rows += r.rows;
+  }
+  std::printf(
+      "%-14s %dD (%zu positions in [%g, %g]^D): max |sum N - 1| %.2e, h max |sum grad N| %.2e, "
+      "max |sum N x_I - x|/h %.2e, max |sum x_I grad N - I| %.2e\n",
+      label.c_str(), D, P.size() * size_t(rounds), lo, hi, e.sum, e.grad, e.repro, e.grad_repro);
+  CHECK(e.sum < 1e-12);
+  CHECK(e.grad < 1e-12);
+  CHECK(e.repro < 1e-12);
+  CHECK(e.grad_repro < 1e-12);
+  CHECK(e.rows == 0);
+}
+
+/// Largest jump of any nodal weight gradient (times h) between x - delta e_0 and x + delta e_0.
+template <int D>
+double gradient_jump(loam::Simulation<D>& sim, std::array<double, D> x, double delta) {
+  auto left = x, right = x;
+  left[0] -= delta;
+  right[0] += delta;
+  auto a = evaluate_at<D>(sim, left), b = evaluate_at<D>(sim, right);
+  for (const auto& [n, v] : b) a[n];  // union of the nodes, zero where absent
+  double jump = 0;
+  for (const auto& [n, va] : a) {
+    const auto it = b.find(n);
+    for (int d = 0; d < D; ++d) {
+      const double vb = it == b.end() ? 0.0 : it->second[size_t(d + 1)];
+      jump = std::max(jump, std::fabs(va[size_t(d + 1)] - vb) * sim.grid.cell[size_t(d)]);
+    }
+  }
+  return jump;
+}
+
+// --- independent 1D reference formulas --------------------------------------------------------
+
+/// Bardenhagen & Kober (2004) uGIMP weight and gradient for lp <= h/2, xi = x_p - x_I.
+std::pair<double, double> gimp_reference(double xi, double lp, double h) {
+  const double r = std::fabs(xi), s = xi > 0 ? 1.0 : (xi < 0 ? -1.0 : 0.0);
+  if (r < lp) return {1 - (xi * xi + lp * lp) / (2 * h * lp), -xi / (h * lp)};
+  if (r < h - lp) return {1 - r / h, -s / h};
+  if (r < h + lp)
+    return {(h + lp - r) * (h + lp - r) / (4 * h * lp), -s * (h + lp - r) / (2 * h * lp)};
+  return {0.0, 0.0};
+}
+
+/// The hat averaged over [xi - lp, xi + lp] for any lp, by the hat's antiderivative.
+std::pair<double, double> hat_average(double xi, double lp, double h) {
+  auto Phi = [](double u) {  // integral of max(0, 1 - |s|) from -inf to u
+    const double c = std::clamp(u, -1.0, 1.0);
+    return 0.5 + c - 0.5 * c * std::fabs(c);
+  };
+  auto hat = [](double u) { return std::max(0.0, 1 - std::fabs(u)); };
+  return {h / (2 * lp) * (Phi((xi + lp) / h) - Phi((xi - lp) / h)),
+          (hat((xi + lp) / h) - hat((xi - lp) / h)) / (2 * lp)};
+}
+
+/// Boundary-modified quadratic B-spline (de Vaucorbeil et al. 2020) of node I on nodes 0..n,
+/// written out per node type; returns weight and gradient at xi (in cells).
+std::pair<double, double> bspline_reference(double xi, int I, int n, double h) {
+  auto interior = [](double u) -> std::pair<double, double> {
+    const double r = std::fabs(u), s = u > 0 ? 1.0 : -1.0;
+    if (r < 0.5) return {0.75 - u * u, -2 * u};
+    if (r < 1.5) return {0.5 * (1.5 - r) * (1.5 - r), -s * (1.5 - r)};
+    return {0, 0};
+  };
+  auto boundary0 = [](double t) -> std::pair<double, double> {  // node 0, t = distance in cells
+    if (t < 0.5) return {1 - t, -1};
+    if (t < 1.5) return {0.5 * (1.5 - t) * (1.5 - t), -(1.5 - t)};
+    return {0, 0};
+  };
+  auto boundary1 = [](double t) -> std::pair<double, double> {  // node 1
+    if (t < 0.5) return {t, 1};
+    if (t < 1.5) return {0.75 - (t - 1) * (t - 1), -2 * (t - 1)};
+    if (t < 2.5) return {0.5 * (2.5 - t) * (2.5 - t), -(2.5 - t)};
+    return {0, 0};
+  };
+  std::pair<double, double> v;
+  if (I == 0) {
+    v = boundary0(xi);
+  } else if (I == 1) {
+    v = boundary1(xi);
+  } else if (I == n) {
+    v = boundary0(n - xi), v.second = -v.second;
+  } else if (I == n - 1) {
+    v = boundary1(n - xi), v.second = -v.second;
+  } else {
+    v = interior(xi - I);
+  }
+  return {v.first, v.second / h};
+}
+
+}  // namespace
+
+TEST_CASE("gimp, bspline2: partition of unity, zero gradient sum, linear reproduction (1D-3D)",
+          "[shape][unit]") {
+  // GIMP: positions with the whole domain inside the grid (lp = 0.025 m); B-splines: anywhere.
+  check_random_consistency<1>("gimp", 0.025, 0.975, "gimp");
+  check_random_consistency<2>("gimp", 0.025, 0.975, "gimp");
+  check_random_consistency<3>("gimp", 0.025, 0.975, "gimp");
+  check_random_consistency<1>("bspline2", 0.0, 1.0, "bspline2");
+  check_random_consistency<2>("bspline2", 0.0, 1.0, "bspline2");
+  check_random_consistency<3>("bspline2", 0.0, 1.0, "bspline2");
+  // Linear, for comparison (and for the row bound of its stencil).
+  check_random_consistency<2>("linear", 0.0, 1.0, "linear");
+}
+
+TEST_CASE("gimp with stretched domains (lp up to one cell): consistency in 1D-3D",
+          "[shape][unit]") {
+  auto run = [](auto dim) {
+    constexpr int D = decltype(dim)::value;
+    auto sim = make_simulation<D>(scene<D>("{type: gimp, domain_update: stretch}"));
+    auto& P = sim->particles;
+    REQUIRE(sim->shape->nodes_per_particle() == loam::ipow(4, D));
+    const int F = P.find("deformation_gradient");
+    const int lp = P.find("gimp_half_width");
+    REQUIRE(F >= 0);
+    REQUIRE(lp >= 0);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> stretch(0.3, 4.0), pos(0.1, 0.9);
+    for (size_t i = 0; i < P.size(); ++i)
+      for (int d = 0; d < D; ++d) {
+        P.col(F, d * D + d)[i] = stretch(rng);  // lp0 = h/4: lp from 0.075 h to h
+        P.col(P.position, d)[i] = pos(rng);     // domain inside the grid
+      }
+    sim->shape->begin_step(*sim);
+    REQUIRE(sim->failure.empty());
+    double worst_lp = 0;
+    for (size_t i = 0; i < P.size(); ++i)
+      for (int d = 0; d < D; ++d)
+        worst_lp = std::max(worst_lp, std::fabs(P.col(lp, d)[i] - 0.025 * P.col(F, d * D + d)[i]));
+    CHECK(worst_lp < 1e-15);
+    const Errors e = consistency(*sim);
+    std::printf(
+        "gimp stretch   %dD: max |sum N - 1| %.2e, h max |sum grad N| %.2e, "
+        "max |sum N x_I - x|/h %.2e, max |sum x_I grad N - I| %.2e\n",
+        D, e.sum, e.grad, e.repro, e.grad_repro);
+    CHECK(e.sum < 1e-12);
+    CHECK(e.grad < 1e-12);
+    CHECK(e.repro < 1e-12);
+    CHECK(e.grad_repro < 1e-12);
+    CHECK(e.rows == 0);
+  };
+  run(std::integral_constant<int, 1>{});
+  run(std::integral_constant<int, 2>{});
+  run(std::integral_constant<int, 3>{});
+}
+
+TEST_CASE("gimp: weights match the Bardenhagen-Kober formulas, a domain straddling a cell face",
+          "[shape][unit]") {
+  auto sim = make_simulation<1>(scene<1>("gimp"));
+  const double h = 0.1, lp = 0.025;
+  // Particle at x_I + 0.1 h (node I = 5 at 0.5 m): its domain [x_I - 0.15 h, x_I + 0.35 h]
+  // straddles the cell face at x_I. By hand (B&K eq. 35): node I: 1 - (0.01 + 0.0625)/0.5 =
+  // 0.855, gradient -0.1/0.25 / h = -4; node I+1 (xi = -0.9 h): 0.35^2 / 1 = 0.1225, gradient
+  // +0.35/0.5 / h = 7; node I-1 (xi = 1.1 h): 0.15^2 = 0.0225, gradient -0.15/0.5 / h = -3.
+  auto v = evaluate_at<1>(*sim, {0.5 + 0.1 * h});
+  std::printf("gimp straddling x_I: N = %.15f %.15f %.15f, dN/dx = %.12f %.12f %.12f\n", v[4][0],
+              v[5][0], v[6][0], v[4][1], v[5][1], v[6][1]);
+  CHECK(v[5][0] == Approx(0.855).epsilon(1e-14));
+  CHECK(v[6][0] == Approx(0.1225).epsilon(1e-14));
+  CHECK(v[4][0] == Approx(0.0225).epsilon(1e-14));
+  CHECK(v[5][1] == Approx(-4.0).epsilon(1e-13));
+  CHECK(v[6][1] == Approx(7.0).epsilon(1e-13));
+  CHECK(v[4][1] == Approx(-3.0).epsilon(1e-13));
+  // Random positions against the piecewise table (every region of it is visited).
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(lp, 1 - lp);
+  double worst_w = 0, worst_g = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const double x = u(rng);
+    auto nv = evaluate_at<1>(*sim, {x});
+    for (int I = 0; I <= 10; ++I) {
+      auto [w, g] = gimp_reference(x - 0.1 * I, lp, h);
+      const auto it = nv.find(I);
+      const double wi = it == nv.end() ? 0.0 : it->second[0];
+      const double gi = it == nv.end() ? 0.0 : it->second[1];
+      worst_w = std::max(worst_w, std::fabs(wi - w));
+      worst_g = std::max(worst_g, std::fabs(gi - g) * h);
+    }
+  }
+  std::printf("gimp vs Bardenhagen-Kober table: max weight error %.2e, max h*gradient error %.2e\n",
+              worst_w, worst_g);
+  CHECK(worst_w < 1e-14);
+  CHECK(worst_g < 1e-13);
+}
+
+TEST_CASE("gimp stretch: lp = lp0 F_xx, above h/2 against the exact hat average, cap and failure",
+          "[shape][unit]") {
+  auto sim = make_simulation<1>(scene<1>("{type: gimp, domain_update: stretch}"));
+  auto& P = sim->particles;
+  const int F = P.find("deformation_gradient");
+  const double h = 0.1;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> pos(0.2, 0.8), stretch(0.2, 4.0);
+  double worst_w = 0, worst_g = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    const double f = stretch(rng), x = pos(rng), lp = 0.025 * f;
+    P.col(F, 0)[0] = f;
+    sim->shape->begin_step(*sim);
+    auto nv = evaluate_at<1>(*sim, {x});
+    for (int I = 0; I <= 10; ++I) {
+      auto [w, g] = hat_average(x - 0.1 * I, lp, h);
+      const auto it = nv.find(I);
+      worst_w = std::max(worst_w, std::fabs((it == nv.end() ? 0.0 : it->second[0]) - w));
+      worst_g = std::max(worst_g, std::fabs((it == nv.end() ? 0.0 : it->second[1]) - g) * h);
+    }
+  }
+  std::printf(
+      "gimp stretch (lp = 0.05h .. h) vs exact hat average: max weight error %.2e, "
+      "max h*gradient error %.2e\n",
+      worst_w, worst_g);
+  CHECK(worst_w < 1e-13);
+  CHECK(worst_g < 1e-12);
+  // Stretched beyond one cell: capped at lp = h (with a warning), consistency kept.
+  P.col(F, 0)[0] = 10.0;
+  sim->shape->begin_step(*sim);
+  CHECK(sim->failure.empty());
+  CHECK(P.col(P.find("gimp_half_width"))[0] == h);
+  auto nv = evaluate_at<1>(*sim, {0.53});
+  double sum = 0;
+  for (const auto& [n, val] : nv) sum += val[0];
+  CHECK(sum == Approx(1.0).epsilon(1e-14));
+  // Inverted domain: the run stops with a message naming the particle.
+  P.col(F, 0)[3] = -0.1;
+  sim->shape->begin_step(*sim);
+  INFO(sim->failure);
+  CHECK(sim->failure.find("GIMP domain inverted") != std::string::npos);
+  CHECK(sim->failure.find("particle " + std::to_string(P.id[3])) != std::string::npos);
+}
+
+TEST_CASE("gimp stretch follows F in a deforming 2D block", "[shape][unit]") {
+  auto sim = make_simulation<2>(
+      "grid: {extent: [1, 1], cell_size: 0.1}\nshape_function: {type: gimp, domain_update: "
+      "stretch}\nbodies:\n  - name: b\n    generator: {type: box, min: [0.2, 0.2], max: [0.8, "
+      "0.8]}\n    material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 1000}\n"
+      "    velocity: {type: sine, amplitude: [0.3, -0.2], wavenumber: [3, 2]}\ntime: {end: 1}\n");
+  loam_test::advance(*sim, 50);
+  sim->shape->begin_step(*sim);
+  auto& P = sim->particles;
+  const int F = P.find("deformation_gradient"), lp = P.find("gimp_half_width");
+  double worst = 0, min_f = 1e9, max_f = 0;
+  for (size_t i = 0; i < P.size(); ++i)
+    for (int d = 0; d < 2; ++d) {
+      const double f = P.col(F, d * 2 + d)[i];
+      min_f = std::min(min_f, f), max_f = std::max(max_f, f);
+      worst = std::max(worst, std::fabs(P.col(lp, d)[i] - 0.025 * f));
+    }
+  std::printf("gimp stretch after 50 steps: F_dd in [%.4f, %.4f], max |lp - lp0 F_dd| %.2e\n",
+              min_f, max_f, worst);
+  CHECK(max_f - min_f > 1e-4);  // the block did deform
+  CHECK(worst < 1e-15);
+  const Errors e = consistency(*sim);
+  CHECK(e.sum < 1e-12);
+  CHECK(e.rows == 0);
+}
+
+TEST_CASE("bspline2: weights match the boundary-modified formulas everywhere in the grid",
+          "[shape][unit]") {
+  auto sim = make_simulation<1>(scene<1>("bspline2"));
+  const double h = 0.1;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double worst_w = 0, worst_g = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const double x = trial < 2 ? double(trial) : u(rng);  // include both grid ends
+    auto nv = evaluate_at<1>(*sim, {x});
+    for (int I = 0; I <= 10; ++I) {
+      auto [w, g] = bspline_reference(x / h, I, 10, h);
+      const auto it = nv.find(I);
+      worst_w = std::max(worst_w, std::fabs((it == nv.end() ? 0.0 : it->second[0]) - w));
+      worst_g = std::max(worst_g, std::fabs((it == nv.end() ? 0.0 : it->second[1]) - g) * h);
+    }
+  }
+  std::printf(
+      "bspline2 vs de Vaucorbeil et al. boundary-modified table: max weight error %.2e, "
+      "max h*gradient error %.2e\n",
+      worst_w, worst_g);
+  CHECK(worst_w < 1e-14);
+  CHECK(worst_g < 1e-13);
+}
+
+TEST_CASE("gimp, bspline2: gradients continuous across cell faces, linear jumps (contrast)",
+          "[shape][unit]") {
+  auto run = [](auto dim) {
+    constexpr int D = decltype(dim)::value;
+    std::array<double, D> face{}, centre{};
+    for (int d = 0; d < D; ++d) face[size_t(d)] = centre[size_t(d)] = 0.437;  // interior point
+    face[0] = 0.5;     // on the cell face x = 0.5 (node 5)
+    centre[0] = 0.45;  // on a cell centre, where the 3-node stencils switch nodes
+    for (std::string shape :
+         {"gimp", "bspline2", "{type: gimp, domain_update: stretch}", "linear"}) {
+      auto sim = make_simulation<D>(scene<D>(shape));
+      double prev = 1e300;
+      for (double delta : {1e-3, 1e-5, 1e-7}) {
+        const double jf = gradient_jump<D>(*sim, face, delta * 0.1);
+        const double jc = gradient_jump<D>(*sim, centre, delta * 0.1);
+        std::printf(
+            "%-38s %dD: gradient jump x h across a cell face %.2e, a cell centre %.2e "
+            "(offset %.0e h)\n",
+            shape.c_str(), D, jf, jc, delta);
+        if (shape == "linear") {
+          CHECK(jf > 0.5);  // the tent's gradient jumps by 1/h at a face: cell-crossing noise
+        } else {
+          CHECK(jf < 20 * delta);  // O(offset): continuous
+          CHECK(jc < 20 * delta);
+          CHECK(jf <= prev);
+          prev = jf;
+        }
+      }
+    }
+  };
+  run(std::integral_constant<int, 1>{});
+  run(std::integral_constant<int, 2>{});
+  run(std::integral_constant<int, 3>{});
+}
+
+TEST_CASE("bspline2: weights at and near the grid boundary (1D-3D)", "[shape][unit]") {
+  const double h = 0.1;
+  {
+    auto sim = make_simulation<1>(scene<1>("bspline2"));
+    // Exactly on the boundary node: N_0 = 1, everything else 0; the same at the far end.
+    auto v = evaluate_at<1>(*sim, {0.0});
+    CHECK(v[0][0] == 1.0);
+    CHECK(v[1][0] == 0.0);
+    CHECK(v[0][1] == Approx(-1 / h).epsilon(1e-14));  // the linear end piece: -1/h, +1/h
+    CHECK(v[1][1] == Approx(1 / h).epsilon(1e-14));
+    v = evaluate_at<1>(*sim, {1.0});
+    CHECK(v[10][0] == Approx(1.0).epsilon(1e-15));
+    CHECK(std::fabs(v[9][0]) < 1e-15);
+    // t = 0.3 cells from the boundary: N_0 = 0.7, N_1 = 0.3 (linear end piece);
+    // t = 0.8: N_0 = 0.7^2/2 = 0.245, N_1 = 3/4 - 0.2^2 = 0.71, N_2 = 0.3^2/2 = 0.045.
+    v = evaluate_at<1>(*sim, {0.03});
+    std::printf("bspline2 at t = 0.3: N_0 %.15f N_1 %.15f N_2 %.15f\n", v[0][0], v[1][0], v[2][0]);
+    CHECK(v[0][0] == Approx(0.7).epsilon(1e-14));
+    CHECK(v[1][0] == Approx(0.3).epsilon(1e-14));
+    CHECK(v[2][0] == 0.0);
+    v = evaluate_at<1>(*sim, {0.08});
+    std::printf("bspline2 at t = 0.8: N_0 %.15f N_1 %.15f N_2 %.15f\n", v[0][0], v[1][0], v[2][0]);
+    CHECK(v[0][0] == Approx(0.245).epsilon(1e-14));
+    CHECK(v[1][0] == Approx(0.71).epsilon(1e-14));
+    CHECK(v[2][0] == Approx(0.045).epsilon(1e-14));
+    v = evaluate_at<1>(*sim, {1.0 - 0.03});  // mirror image at the far end
+    CHECK(v[10][0] == Approx(0.7).epsilon(1e-13));
+    CHECK(v[9][0] == Approx(0.3).epsilon(1e-13));
+    // The modified functions stay C1 where the linear end piece meets the spline (t = 1/2).
+    const double jump = gradient_jump<1>(*sim, {0.05}, 1e-9);
+    std::printf("bspline2 gradient jump x h at t = 1/2 from the boundary: %.2e\n", jump);
+    CHECK(jump < 1e-6);
+  }
+  // Corners of the grid in 2D and 3D, on and near the boundary: consistency holds to round-off.
+  auto corners = [](auto dim) {
+    constexpr int D = decltype(dim)::value;
+    auto sim = make_simulation<D>(scene<D>("bspline2"));
+    auto& P = sim->particles;
+    const double offsets[] = {0.0, 1e-12, 0.003, 0.05, 0.07, 0.1, 0.14};
+    size_t i = 0;
+    for (double a : offsets)
+      for (double b : offsets) {
+        if (i >= P.size()) break;
+        for (int d = 0; d < D; ++d) {
+          const double o = d == 0 ? a : b;
+          P.col(P.position, d)[i] = (i % 2 ? 1.0 - o : o);  // low and high corners
+        }
+        ++i;
+      }
+    const Errors e = consistency(*sim);
+    std::printf(
+        "bspline2 %dD near/on the grid corners: max |sum N - 1| %.2e, h max |sum grad N| "
+        "%.2e, max |sum N x_I - x|/h %.2e, max |sum x_I grad N - I| %.2e\n",
+        D, e.sum, e.grad, e.repro, e.grad_repro);
+    CHECK(e.sum < 1e-12);
+    CHECK(e.grad < 1e-12);
+    CHECK(e.repro < 1e-12);
+    CHECK(e.grad_repro < 1e-12);
+    CHECK(e.rows == 0);
+  };
+  corners(std::integral_constant<int, 2>{});
+  corners(std::integral_constant<int, 3>{});
+}
+
+TEST_CASE("gimp: weights at and near the grid boundary (documented loss of partition of unity)",
+          "[shape][unit]") {
+  const double h = 0.1, lp = 0.025, a = lp / h;
+  auto sim = make_simulation<1>(scene<1>("gimp"));
+  // Domain touching the boundary from inside (x = lp): partition of unity and reproduction hold.
+  for (double x : {lp, 1.0 - lp, 0.03}) {
+    auto v = evaluate_at<1>(*sim, {x});
+    double sum = 0, xr = 0, gsum = 0;
+    for (const auto& [n, val] : v) sum += val[0], xr += val[0] * 0.1 * n, gsum += val[1];
+    std::printf(
+        "gimp at x = %.3f (domain inside the grid): sum N - 1 = %.2e, sum N x_I - x = "
+        "%.2e, h sum dN = %.2e\n",
+        x, sum - 1, xr - x, gsum * h);
+    CHECK(std::fabs(sum - 1) < 1e-14);
+    CHECK(std::fabs(xr - x) < 1e-15);
+    CHECK(std::fabs(gsum * h) < 1e-13);
+  }
+  // Exactly on the boundary: half the domain is outside the grid. Node 0 gets 1 - a/2, node 1
+  // gets a/4 and the missing node -1 (zero weight) would have had a/4: sum N = 1 - lp/(4h).
+  for (double x : {0.0, 1.0}) {
+    auto v = evaluate_at<1>(*sim, {x});
+    const int b = x == 0.0 ? 0 : 10, in = x == 0.0 ? 1 : 9;
+    double sum = 0;
+    for (const auto& [n, val] : v) sum += val[0];
+    std::printf(
+        "gimp exactly on the boundary x = %.0f: N_b %.15f, N_in %.15f, sum N = %.15f "
+        "(1 - lp/4h = %.15f)\n",
+        x, v[b][0], v[in][0], sum, 1 - a / 4);
+    CHECK(v[b][0] == Approx(1 - a / 2).epsilon(1e-14));
+    CHECK(v[in][0] == Approx(a / 4).epsilon(1e-14));
+    CHECK(sum == Approx(1 - a / 4).epsilon(1e-14));
+  }
+  // In 2D and 3D the entries outside the grid are valid nodes with zero weight and the deficit is
+  // the product of the per-axis sums, e.g. (1 - a/4)^D at a corner.
+  auto corner = [&](auto dim) {
+    constexpr int D = decltype(dim)::value;
+    auto s = make_simulation<D>(scene<D>("gimp"));
+    std::array<double, D> x{};
+    auto v = evaluate_at<D>(*s, x);  // evaluate_at checks the node indices
+    double sum = 0;
+    for (const auto& [n, val] : v) sum += val[0];
+    std::printf("gimp %dD particle on the grid corner: sum N = %.15f ((1 - lp/4h)^D = %.15f)\n", D,
+                sum, std::pow(1 - a / 4, D));
+    CHECK(sum == Approx(std::pow(1 - a / 4, D)).epsilon(1e-14));
+  };
+  corner(std::integral_constant<int, 2>{});
+  corner(std::integral_constant<int, 3>{});
+}
+
+TEST_CASE("vibrating bar with gimp and bspline2 through the CLI: period and energy",
+          "[shape][verification]") {
+  // VERIFICATION.md A: T = 10 s; tolerances from issue 3/4: period error < 1 %, energy drift < 1 %.
+  for (std::string shape : {"gimp", "bspline2"}) {
+    loam_test::TempDir dir("bar_" + shape);
+    auto s = loam_test::run_scene("vibrating_bar.yaml", dir.path, "--set shape_function=" + shape);
+    auto v = s["verify"];
+    REQUIRE(s["shape_function"].dump().find(shape) != std::string::npos);
+    const double period_error = v["period_error"], drift = v["energy_drift"];
+    std::printf(
+        "vibrating bar %-8s: period %.6f s (exact %.6f), error %.3e; energy drift %.3e; "
+        "tip amplitude error %.3e; %g periods\n",
+        shape.c_str(), v["period_measured"].get<double>(), v["period_exact"].get<double>(),
+        period_error, drift, v["amplitude_error"].get<double>(),
+        v["periods_observed"].get<double>());
+    CHECK(v["periods_observed"].get<double>() >= 9);
+    CHECK(period_error < 0.01);
+    CHECK(drift < 0.01);
+  }
+}
