@@ -27,6 +27,7 @@
 // all non-negative and C1. Half a cell next to the boundary the basis is the linear one.
 // Stencil entries whose node is outside the grid (the ghosts) carry the nearest valid node index
 // and zero weight and gradient.
+#include "framework/axis_stencil.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 
@@ -49,12 +50,13 @@ class BSpline2 : public ShapeFunction<D> {
 
   void evaluate(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
                 StencilBlock<D>& out) const override {
-    constexpr int M = 3, K = ipow(3, D);
+    constexpr int M = 3;
     out.count = count;
-    // Per-axis weights first (vectorises across particles), then the tensor products,
-    // node-major so that each inner loop runs over contiguous particles.
-    alignas(64) double w[D][M][kBlock], dw[D][M][kBlock];
-    alignas(64) int32_t node[D][M][kBlock];
+    // Per-axis weights first (vectorises across particles), then the tensor products.
+    AxisStencil<D, M> ax;
+    auto& w = ax.w;
+    auto& dw = ax.dw;
+    auto& node = ax.node;
     for (int d = 0; d < D; ++d) {
       const double* x = P.col(P.position, d) + begin;
       const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
@@ -92,31 +94,7 @@ class BSpline2 : public ShapeFunction<D> {
         node[d][2][p] = (b < n ? b + 1 : n) * stride;
       }
     }
-    for (int k = 0; k < K; ++k) {
-      int j[D];
-      for (int d = 0, r = k; d < D; ++d, r /= M) j[d] = r % M;
-      int32_t* node_k = out.node.data() + size_t(k) * kBlock;
-      double* w_k = out.w.data() + size_t(k) * kBlock;
-      for (int p = 0; p < count; ++p) {
-        int32_t nk = 0;
-        double wp = 1.0;
-        for (int d = 0; d < D; ++d) {
-          nk += node[d][j[d]][p];
-          wp *= w[d][j[d]][p];
-        }
-        node_k[p] = nk;
-        w_k[p] = wp;
-      }
-      for (int d = 0; d < D; ++d) {
-        double* gr = out.grad.data() + (size_t(k) * D + size_t(d)) * kBlock;
-        for (int p = 0; p < count; ++p) {
-          double gp = dw[d][j[d]][p];
-          for (int e = 0; e < D; ++e)
-            if (e != d) gp *= w[e][j[e]][p];
-          gr[p] = gp;
-        }
-      }
-    }
+    ax.tensor_product(count, out);
   }
 };
 

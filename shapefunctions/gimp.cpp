@@ -41,52 +41,11 @@
 #include <array>
 #include <cmath>
 
+#include "framework/axis_stencil.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 
 namespace loam {
-
-namespace {
-
-/// Per-axis weights, gradients and node offsets (node coordinate times stride) of M nodes for a
-/// block of particles, and their tensor product into the stencil, node-major.
-template <int D, int M>
-struct GimpAxes {
-  alignas(64) double w[D][M][kBlock];
-  alignas(64) double dw[D][M][kBlock];
-  alignas(64) int32_t node[D][M][kBlock];
-
-  void tensor_product(int count, StencilBlock<D>& out) const {
-    constexpr int K = ipow(M, D);
-    for (int k = 0; k < K; ++k) {
-      int j[D];
-      for (int d = 0, r = k; d < D; ++d, r /= M) j[d] = r % M;
-      int32_t* node_k = out.node.data() + size_t(k) * kBlock;
-      double* w_k = out.w.data() + size_t(k) * kBlock;
-      for (int p = 0; p < count; ++p) {
-        int32_t n = 0;
-        double wp = 1.0;
-        for (int d = 0; d < D; ++d) {
-          n += node[d][j[d]][p];
-          wp *= w[d][j[d]][p];
-        }
-        node_k[p] = n;
-        w_k[p] = wp;
-      }
-      for (int d = 0; d < D; ++d) {
-        double* gr = out.grad.data() + (size_t(k) * D + size_t(d)) * kBlock;
-        for (int p = 0; p < count; ++p) {
-          double gp = dw[d][j[d]][p];
-          for (int e = 0; e < D; ++e)
-            if (e != d) gp *= w[e][j[e]][p];
-          gr[p] = gp;
-        }
-      }
-    }
-  }
-};
-
-}  // namespace
 
 template <int D>
 class Gimp : public ShapeFunction<D> {
@@ -216,7 +175,7 @@ class Gimp : public ShapeFunction<D> {
   void evaluate_m(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
                   StencilBlock<D>& out) const {
     out.count = count;
-    GimpAxes<D, M> ax;
+    AxisStencil<D, M> ax;
     for (int d = 0; d < D; ++d) {
       const double* x = P.col(P.position, d) + begin;
       const double* lp = P.col(half_width_, d) + begin;

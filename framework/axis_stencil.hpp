@@ -1,0 +1,48 @@
+#pragma once
+// Tensor-product stencils: shape functions that are products of 1D functions (linear-like,
+// GIMP, B-splines) fill per-axis weights, gradients and node offsets for a block of particles,
+// then expand them into the StencilBlock node-major, so every inner loop runs over contiguous
+// particles and vectorises.
+#include "shape_function.hpp"
+
+namespace loam {
+
+/// Per-axis weights, gradients and node offsets (node coordinate times stride) of M nodes for a
+/// block of particles, and their tensor product into the stencil, node-major.
+template <int D, int M>
+struct AxisStencil {
+  alignas(64) double w[D][M][kBlock];
+  alignas(64) double dw[D][M][kBlock];
+  alignas(64) int32_t node[D][M][kBlock];
+
+  void tensor_product(int count, StencilBlock<D>& out) const {
+    constexpr int K = ipow(M, D);
+    for (int k = 0; k < K; ++k) {
+      int j[D];
+      for (int d = 0, r = k; d < D; ++d, r /= M) j[d] = r % M;
+      int32_t* node_k = out.node.data() + size_t(k) * kBlock;
+      double* w_k = out.w.data() + size_t(k) * kBlock;
+      for (int p = 0; p < count; ++p) {
+        int32_t n = 0;
+        double wp = 1.0;
+        for (int d = 0; d < D; ++d) {
+          n += node[d][j[d]][p];
+          wp *= w[d][j[d]][p];
+        }
+        node_k[p] = n;
+        w_k[p] = wp;
+      }
+      for (int d = 0; d < D; ++d) {
+        double* gr = out.grad.data() + (size_t(k) * D + size_t(d)) * kBlock;
+        for (int p = 0; p < count; ++p) {
+          double gp = dw[d][j[d]][p];
+          for (int e = 0; e < D; ++e)
+            if (e != d) gp *= w[e][j[e]][p];
+          gr[p] = gp;
+        }
+      }
+    }
+  }
+};
+
+}  // namespace loam
