@@ -10,6 +10,7 @@
 
 #include "cli.hpp"
 #include "sim_helpers.hpp"
+#include "stencil_checks.hpp"
 
 using loam_test::make_simulation;
 
@@ -57,54 +58,6 @@ NodeValues<D> evaluate_at(loam::Simulation<D>& sim, const std::array<double, D>&
   return out;
 }
 
-struct Errors {
-  double sum = 0, grad = 0, repro = 0, grad_repro = 0, rows = 0;
-};
-
-/// Evaluate every particle (in full blocks) and measure the consistency errors: |sum N - 1|,
-/// h |sum grad N|, |sum N x_I - x_p| / h, |sum x_I (x) grad N - I|, and stencil entries outside
-/// the node rows [r - rows_below, r + rows_above] (must be 0).
-template <int D>
-Errors consistency(loam::Simulation<D>& sim) {
-  auto& P = sim.particles;
-  const auto& g = sim.grid;
-  loam::StencilBlock<D> st;
-  st.allocate(sim.shape->nodes_per_particle());
-  Errors e;
-  for (size_t b = 0; b < P.size(); b += loam::kBlock) {
-    const int count = int(std::min<size_t>(loam::kBlock, P.size() - b));
-    sim.shape->evaluate(g, P, b, count, st);
-    for (int p = 0; p < count; ++p) {
-      double sum = 0, gsum[D] = {}, xr[D] = {}, gx[D][D] = {};
-      const int row = g.cell_of(P.col(P.position, D - 1)[b + size_t(p)], D - 1);
-      for (int k = 0; k < st.npp; ++k) {
-        const size_t kp = size_t(k) * loam::kBlock + size_t(p);
-        const int node_row = g.node_ijk(size_t(st.node[kp]))[D - 1];
-        if (node_row < row - sim.shape->rows_below() || node_row > row + sim.shape->rows_above())
-          e.rows += 1;
-        sum += st.w[kp];
-        for (int i = 0; i < D; ++i) {
-          const double xi = g.node_coord(size_t(st.node[kp]), i);
-          xr[i] += st.w[kp] * xi;
-          for (int j = 0; j < D; ++j)
-            gx[i][j] += xi * st.grad[(size_t(k) * D + size_t(j)) * loam::kBlock + size_t(p)];
-        }
-        for (int j = 0; j < D; ++j)
-          gsum[j] += st.grad[(size_t(k) * D + size_t(j)) * loam::kBlock + size_t(p)];
-      }
-      e.sum = std::max(e.sum, std::fabs(sum - 1));
-      for (int i = 0; i < D; ++i) {
-        e.grad = std::max(e.grad, std::fabs(gsum[i]) * g.cell[size_t(i)]);
-        e.repro = std::max(
-            e.repro, std::fabs(xr[i] - P.col(P.position, i)[b + size_t(p)]) / g.cell[size_t(i)]);
-        for (int j = 0; j < D; ++j)
-          e.grad_repro = std::max(e.grad_repro, std::fabs(gx[i][j] - (i == j ? 1.0 : 0.0)));
-      }
-    }
-  }
-  return e;
-}
-
 /// Place every particle at a random position in [lo, hi]^D and check the consistency errors.
 template <int D>
 void check_random_consistency(const std::string& shape, double lo, double hi,
@@ -115,11 +68,11 @@ void check_random_consistency(const std::string& shape, double lo, double hi,
   std::uniform_real_distribution<double> u(lo, hi);
   // At least ~1500 random positions per dimension (the 1D block has only 12 particles).
   const int rounds = int(1500 / P.size()) + 1;
-  Errors e;
+  loam_test::StencilErrors e;
   for (int round = 0; round < rounds; ++round) {
     for (size_t i = 0; i < P.size(); ++i)
       for (int d = 0; d < D; ++d) P.col(P.position, d)[i] = u(rng);
-    const Errors r = consistency(*sim);
+    const auto r = loam_test::stencil_consistency(*sim);
     e.sum = std::max(e.sum, r.sum), e.grad = std::max(e.grad, r.grad);
     e.repro = std::max(e.repro, r.repro), e.grad_repro = std::max(e.grad_repro, r.grad_repro);
     e.rows += r.rows;
@@ -252,7 +205,7 @@ TEST_CASE("gimp with stretched domains (lp up to one cell): consistency in 1D-3D
       for (int d = 0; d < D; ++d)
         worst_lp = std::max(worst_lp, std::fabs(P.col(lp, d)[i] - 0.025 * P.col(F, d * D + d)[i]));
     CHECK(worst_lp < 1e-15);
-    const Errors e = consistency(*sim);
+    const auto e = loam_test::stencil_consistency(*sim);
     std::printf(
         "gimp stretch   %dD: max |sum N - 1| %.2e, h max |sum grad N| %.2e, "
         "max |sum N x_I - x|/h %.2e, max |sum x_I grad N - I| %.2e\n",
@@ -372,7 +325,7 @@ TEST_CASE("gimp stretch follows F in a deforming 2D block", "[shape][unit]") {
               min_f, max_f, worst);
   CHECK(max_f - min_f > 1e-4);  // the block did deform
   CHECK(worst < 1e-15);
-  const Errors e = consistency(*sim);
+  const auto e = loam_test::stencil_consistency(*sim);
   CHECK(e.sum < 1e-12);
   CHECK(e.rows == 0);
 }
@@ -486,7 +439,7 @@ TEST_CASE("bspline2: weights at and near the grid boundary (1D-3D)", "[shape][un
         }
         ++i;
       }
-    const Errors e = consistency(*sim);
+    const auto e = loam_test::stencil_consistency(*sim);
     std::printf(
         "bspline2 %dD near/on the grid corners: max |sum N - 1| %.2e, h max |sum grad N| "
         "%.2e, max |sum N x_I - x|/h %.2e, max |sum x_I grad N - I| %.2e\n",

@@ -5,6 +5,7 @@
 
 #include "framework/tensor.hpp"
 #include "sim_helpers.hpp"
+#include "stencil_checks.hpp"
 
 using loam_test::advance;
 using loam_test::make_simulation;
@@ -28,33 +29,16 @@ TEST_CASE("linear shape function: partition of unity, zero gradient sum, linear 
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (size_t i = 0; i < P.size(); ++i)
     for (int d = 0; d < 2; ++d) P.col(P.position, d)[i] = u(rng);  // anywhere in the grid
-  loam::StencilBlock<2> st;
-  st.allocate(sim->shape->nodes_per_particle());
-  double worst_sum = 0, worst_grad = 0, worst_repro = 0;
-  for (size_t b = 0; b < P.size(); b += loam::kBlock) {
-    int count = int(std::min<size_t>(loam::kBlock, P.size() - b));
-    sim->shape->evaluate(sim->grid, P, b, count, st);
-    for (int p = 0; p < count; ++p) {
-      double sum = 0, gsum[2] = {0, 0}, xr[2] = {0, 0};
-      for (int k = 0; k < st.npp; ++k) {
-        size_t kp = size_t(k) * loam::kBlock + size_t(p);
-        sum += st.w[kp];
-        for (int d = 0; d < 2; ++d) {
-          gsum[d] += st.grad[(size_t(k) * 2 + size_t(d)) * loam::kBlock + size_t(p)];
-          xr[d] += st.w[kp] * sim->grid.node_coord(size_t(st.node[kp]), d);
-        }
-      }
-      worst_sum = std::max(worst_sum, std::fabs(sum - 1));
-      worst_grad = std::max({worst_grad, std::fabs(gsum[0]), std::fabs(gsum[1])});
-      for (int d = 0; d < 2; ++d)
-        worst_repro = std::max(worst_repro, std::fabs(xr[d] - P.col(P.position, d)[b + size_t(p)]));
-    }
-  }
-  std::printf("linear: max |sum N - 1| %.2e, max |sum dN| %.2e, max |sum N x_I - x| %.2e\n",
-              worst_sum, worst_grad, worst_repro);
-  CHECK(worst_sum < 1e-14);
-  CHECK(worst_grad < 1e-12);
-  CHECK(worst_repro < 1e-14);
+  const auto e = loam_test::stencil_consistency(*sim);
+  std::printf(
+      "linear: max |sum N - 1| %.2e, h max |sum dN| %.2e, max |sum N x_I - x|/h %.2e, "
+      "max |sum x_I dN - I| %.2e, entries outside the declared rows %g\n",
+      e.sum, e.grad, e.repro, e.grad_repro, e.rows);
+  CHECK(e.sum < 1e-14);
+  CHECK(e.grad < 1e-13);
+  CHECK(e.repro < 1e-13);
+  CHECK(e.grad_repro < 1e-12);
+  CHECK(e.rows == 0);
 }
 
 TEST_CASE("deformation gradient, when requested, stays consistent with the volume update",

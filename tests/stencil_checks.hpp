@@ -1,0 +1,63 @@
+#pragma once
+// Consistency checks shared by the shape-function tests: evaluate every particle's stencil and
+// measure |sum N - 1|, h |sum grad N|, |sum N x_I - x_p| / h, |sum x_I (x) grad N - I|, and
+// stencil entries outside the node rows [r - rows_below, r + rows_above] the shape function
+// declares for race-free scatter (must be 0).
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "framework/simulation.hpp"
+
+namespace loam_test {
+
+struct StencilErrors {
+  double sum = 0, grad = 0, repro = 0, grad_repro = 0, rows = 0;
+};
+
+/// Evaluate every particle (in full blocks) and measure the consistency errors: |sum N - 1|,
+/// h |sum grad N|, |sum N x_I - x_p| / h, |sum x_I (x) grad N - I|, and stencil entries outside
+/// the node rows [r - rows_below, r + rows_above] (must be 0).
+template <int D>
+StencilErrors stencil_consistency(loam::Simulation<D>& sim) {
+  auto& P = sim.particles;
+  const auto& g = sim.grid;
+  loam::StencilBlock<D> st;
+  st.allocate(sim.shape->nodes_per_particle());
+  StencilErrors e;
+  for (size_t b = 0; b < P.size(); b += loam::kBlock) {
+    const int count = int(std::min<size_t>(loam::kBlock, P.size() - b));
+    sim.shape->evaluate(g, P, b, count, st);
+    for (int p = 0; p < count; ++p) {
+      double sum = 0, gsum[D] = {}, xr[D] = {}, gx[D][D] = {};
+      const int row = g.cell_of(P.col(P.position, D - 1)[b + size_t(p)], D - 1);
+      for (int k = 0; k < st.npp; ++k) {
+        const size_t kp = size_t(k) * loam::kBlock + size_t(p);
+        REQUIRE(st.node[kp] >= 0);
+        REQUIRE(size_t(st.node[kp]) < g.num_nodes);
+        const int node_row = g.node_ijk(size_t(st.node[kp]))[D - 1];
+        if (node_row < row - sim.shape->rows_below() || node_row > row + sim.shape->rows_above())
+          e.rows += 1;
+        sum += st.w[kp];
+        for (int i = 0; i < D; ++i) {
+          const double xi = g.node_coord(size_t(st.node[kp]), i);
+          xr[i] += st.w[kp] * xi;
+          for (int j = 0; j < D; ++j)
+            gx[i][j] += xi * st.grad[(size_t(k) * D + size_t(j)) * loam::kBlock + size_t(p)];
+        }
+        for (int j = 0; j < D; ++j)
+          gsum[j] += st.grad[(size_t(k) * D + size_t(j)) * loam::kBlock + size_t(p)];
+      }
+      e.sum = std::max(e.sum, std::fabs(sum - 1));
+      for (int i = 0; i < D; ++i) {
+        e.grad = std::max(e.grad, std::fabs(gsum[i]) * g.cell[size_t(i)]);
+        e.repro = std::max(
+            e.repro, std::fabs(xr[i] - P.col(P.position, i)[b + size_t(p)]) / g.cell[size_t(i)]);
+        for (int j = 0; j < D; ++j)
+          e.grad_repro = std::max(e.grad_repro, std::fabs(gx[i][j] - (i == j ? 1.0 : 0.0)));
+      }
+    }
+  }
+  return e;
+}
+
+}  // namespace loam_test
