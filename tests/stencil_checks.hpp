@@ -3,8 +3,10 @@
 // measure |sum N - 1|, h |sum grad N|, |sum N x_I - x_p| / h, |sum x_I (x) grad N - I|, and
 // stencil entries outside the node rows [r - rows_below, r + rows_above] the shape function
 // declares for race-free scatter (must be 0).
+#include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <map>
 
 #include "framework/simulation.hpp"
 
@@ -58,6 +60,30 @@ StencilErrors stencil_consistency(loam::Simulation<D>& sim) {
     }
   }
   return e;
+}
+
+/// Weight and gradient per node of one particle, summed over stencil entries (entries for nodes
+/// outside the grid map to a valid node with zero weight, and CPDI repeats nodes, so summing is
+/// exact).
+template <int D>
+using NodeValues = std::map<int32_t, std::array<double, D + 1>>;
+
+template <int D>
+NodeValues<D> node_values(loam::Simulation<D>& sim, size_t particle) {
+  loam::StencilBlock<D> st;
+  st.allocate(sim.shape->nodes_per_particle());
+  sim.shape->evaluate(sim.grid, sim.particles, particle, 1, st);
+  NodeValues<D> out;
+  for (int k = 0; k < st.npp; ++k) {
+    const size_t kp = size_t(k) * loam::kBlock;
+    REQUIRE(st.node[kp] >= 0);
+    REQUIRE(size_t(st.node[kp]) < sim.grid.num_nodes);
+    auto& v = out[st.node[kp]];
+    v[0] += st.w[kp];
+    for (int d = 0; d < D; ++d)
+      v[size_t(d + 1)] += st.grad[(size_t(k) * D + size_t(d)) * loam::kBlock];
+  }
+  return out;
 }
 
 }  // namespace loam_test

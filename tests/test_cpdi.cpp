@@ -69,25 +69,8 @@ void check_consistency(loam::Simulation<D>& sim, const std::string& label) {
   CHECK(e.grad_repro < 1e-11);
 }
 
-/// Per node of one particle: weight and gradient summed over stencil entries.
-template <int D>
-using NodeValues = std::map<int32_t, std::array<double, D + 1>>;
-
-template <int D>
-NodeValues<D> node_values(loam::Simulation<D>& sim, size_t particle) {
-  loam::StencilBlock<D> st;
-  st.allocate(sim.shape->nodes_per_particle());
-  sim.shape->evaluate(sim.grid, sim.particles, particle, 1, st);
-  NodeValues<D> out;
-  for (int k = 0; k < st.npp; ++k) {
-    const size_t kp = size_t(k) * loam::kBlock;
-    auto& v = out[st.node[kp]];
-    v[0] += st.w[kp];
-    for (int d = 0; d < D; ++d)
-      v[size_t(d + 1)] += st.grad[(size_t(k) * D + size_t(d)) * loam::kBlock];
-  }
-  return out;
-}
+using loam_test::node_values;
+using loam_test::NodeValues;
 
 /// Tent function of node n at x (independent of the plugin).
 template <int D>

@@ -32,30 +32,14 @@ std::string scene(const std::string& shape, int ppc = 2) {
          "time: {end: 1}\n";
 }
 
-/// Weight and gradient per node of one particle, summed over stencil entries (entries for nodes
-/// outside the grid map to a valid node with zero weight, so summing is exact).
-template <int D>
-using NodeValues = std::map<int32_t, std::array<double, D + 1>>;
+using loam_test::NodeValues;
 
+/// Weights and gradients per node with particle `particle` moved to x.
 template <int D>
 NodeValues<D> evaluate_at(loam::Simulation<D>& sim, const std::array<double, D>& x,
                           size_t particle = 0) {
-  auto& P = sim.particles;
-  for (int d = 0; d < D; ++d) P.col(P.position, d)[particle] = x[size_t(d)];
-  loam::StencilBlock<D> st;
-  st.allocate(sim.shape->nodes_per_particle());
-  sim.shape->evaluate(sim.grid, P, particle, 1, st);
-  NodeValues<D> out;
-  for (int k = 0; k < st.npp; ++k) {
-    const size_t kp = size_t(k) * loam::kBlock;
-    REQUIRE(st.node[kp] >= 0);
-    REQUIRE(size_t(st.node[kp]) < sim.grid.num_nodes);
-    auto& v = out[st.node[kp]];
-    v[0] += st.w[kp];
-    for (int d = 0; d < D; ++d)
-      v[size_t(d + 1)] += st.grad[(size_t(k) * D + size_t(d)) * loam::kBlock];
-  }
-  return out;
+  for (int d = 0; d < D; ++d) sim.particles.col(sim.particles.position, d)[particle] = x[size_t(d)];
+  return loam_test::node_values(sim, particle);
 }
 
 /// Place every particle at a random position in [lo, hi]^D and check the consistency errors.
