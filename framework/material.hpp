@@ -2,6 +2,8 @@
 // Constitutive-model plugin interface. The framework calls update_stress once per contiguous
 // batch of particles of this material (never once per particle), handing it the velocity
 // gradient of the batch. Stress is Cauchy, tension positive, Voigt order xx yy zz xy yz xz.
+#include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "particles.hpp"
@@ -41,5 +43,17 @@ class Material {
     return std::numeric_limits<double>::quiet_NaN();
   }
 };
+
+/// P-wave speed sqrt(M / rho) of particles [begin, end) for a constrained modulus M (Pa):
+/// fastest where the density m / V is lowest, i.e. in stretched particles.
+template <int D>
+double p_wave_speed(const Particles<D>& P, size_t begin, size_t end, double M) {
+  double rho_min = std::numeric_limits<double>::infinity();
+  const double* m = P.col(P.mass);
+  const double* V = P.col(P.volume);
+#pragma omp parallel for reduction(min : rho_min) schedule(static)
+  for (size_t i = begin; i < end; ++i) rho_min = std::min(rho_min, m[i] / V[i]);
+  return std::sqrt(M / std::max(rho_min, 1e-300));
+}
 
 }  // namespace loam

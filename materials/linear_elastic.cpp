@@ -34,13 +34,7 @@ class LinearElastic : public Material<D> {
   double density() const override { return rho_; }
 
   double wave_speed(const Particles<D>& P, size_t b, size_t e) const override {
-    // c_p = sqrt(M / rho): fastest where the density is lowest (stretched particles).
-    double rho_min = std::numeric_limits<double>::infinity();
-    const double* m = P.col(P.mass);
-    const double* V = P.col(P.volume);
-#pragma omp parallel for reduction(min : rho_min) schedule(static)
-    for (size_t i = b; i < e; ++i) rho_min = std::min(rho_min, m[i] / V[i]);
-    return std::sqrt(M_ / std::max(rho_min, 1e-300));
+    return p_wave_speed(P, b, e, M_);
   }
 
   void update_stress(const MaterialBatch<D>& batch) override {
