@@ -56,4 +56,28 @@ double p_wave_speed(const Particles<D>& P, size_t begin, size_t end, double M) {
   return std::sqrt(M / std::max(rho_min, 1e-300));
 }
 
+/// Elastic energy density 1/2 sigma : C^-1 : sigma (J/m^3) of a Voigt stress (xx yy zz xy yz xz)
+/// for isotropic elasticity (E, nu).
+inline double isotropic_energy_density(const double (&sv)[6], double E, double nu) {
+  const double tr = sv[0] + sv[1] + sv[2];
+  double ss = 0;
+  for (int c = 0; c < 6; ++c) ss += (c < 3 ? 1.0 : 2.0) * sv[c] * sv[c];
+  return 0.5 * ((1 + nu) * ss - nu * tr * tr) / E;
+}
+
+/// Stored elastic energy of particles [begin, end) for isotropic elasticity (E, nu).
+template <int D>
+double isotropic_elastic_energy(const Particles<D>& P, size_t begin, size_t end, double E,
+                                double nu) {
+  constexpr int NS = Particles<D>::NS;
+  const double* V = P.col(P.volume);
+  double sum = 0;
+  for (size_t i = begin; i < end; ++i) {
+    double sv[6] = {0, 0, 0, 0, 0, 0};
+    for (int c = 0; c < NS; ++c) sv[c] = P.col(P.stress, c)[i];
+    sum += V[i] * isotropic_energy_density(sv, E, nu);
+  }
+  return sum;
+}
+
 }  // namespace loam

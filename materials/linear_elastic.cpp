@@ -47,19 +47,7 @@ class LinearElastic : public Material<D> {
   }
 
   double strain_energy(const Particles<D>& P, size_t b, size_t e) const override {
-    // W = 1/2 sigma : C^-1 : sigma V, with C^-1 from E and nu (3D, all components).
-    constexpr int NS = Particles<D>::NS;
-    const double* V = P.col(P.volume);
-    double sum = 0;
-    for (size_t i = b; i < e; ++i) {
-      double sv[6] = {0, 0, 0, 0, 0, 0};
-      for (int c = 0; c < NS; ++c) sv[c] = P.col(P.stress, c)[i];
-      const double tr = sv[0] + sv[1] + sv[2];
-      double ss = 0;
-      for (int c = 0; c < 6; ++c) ss += (c < 3 ? 1.0 : 2.0) * sv[c] * sv[c];
-      sum += 0.5 * V[i] * ((1 + nu_) * ss - nu_ * tr * tr) / E_;
-    }
-    return sum;
+    return isotropic_elastic_energy(P, b, e, E_, nu_);
   }
 
  private:

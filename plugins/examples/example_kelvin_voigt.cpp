@@ -112,10 +112,7 @@ class KelvinVoigt : public loam::Material<D> {
     for (size_t i = b; i < e; ++i) {
       double sv[6] = {0, 0, 0, 0, 0, 0};
       for (int c = 0; c < NS; ++c) sv[c] = P.col(P.stress, c)[i] - P.col(viscous_, c)[i];
-      const double tr = sv[0] + sv[1] + sv[2];
-      double ss = 0;
-      for (int c = 0; c < 6; ++c) ss += (c < 3 ? 1.0 : 2.0) * sv[c] * sv[c];
-      sum += 0.5 * V[i] * ((1 + nu_) * ss - nu_ * tr * tr) / E_;
+      sum += V[i] * loam::isotropic_energy_density(sv, E_, nu_);
     }
     return sum;
   }
