@@ -39,7 +39,6 @@ void Partition<D>::sort(Particles<D>& p, const Grid<D>& g, int num_materials, in
   // Cut the cell order into slabs of equal particle count (cuts may fall inside a row), as many
   // as keep same-colour slabs apart: 2 per colour per thread, fewer if the slabs get too thin.
   // Balanced slabs matter: a colour phase lasts as long as its busiest thread.
-  const size_t row_cells = ncells / size_t(g.cells[D - 1]);
   std::vector<size_t> before(ncells + 1, 0);  // particles in cells < c, over all materials
   for (size_t c = 0; c <= ncells; ++c)
     for (int m = 0; m < num_materials; ++m)
@@ -55,8 +54,6 @@ void Partition<D>::sort(Particles<D>& p, const Grid<D>& g, int num_materials, in
                                before.begin());
       c1 = std::min(c1, ncells);
       Slab slab;
-      slab.row_begin = int(c0 / row_cells);
-      slab.row_end = int((c1 + row_cells - 1) / row_cells);
       for (int m = 0; m < num_materials; ++m) {
         IndexRange r{counts_[size_t(m) * ncells + c0], counts_[size_t(m) * ncells + c1]};
         if (r.end > r.begin) slab.ranges.push_back(r);

@@ -33,7 +33,6 @@ class Partition {
  public:
   struct Slab {
     std::vector<IndexRange> ranges;  // one per material with particles in the slab
-    int row_begin = 0, row_end = 0;  // cell rows overlapped at sort time
     int row_min = 0, row_max = -1;   // actual rows spanned now
   };
 

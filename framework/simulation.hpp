@@ -73,7 +73,6 @@ class Simulation {
   double mass_tolerance = 1e-12;  // nodes lighter than this (kg) get no velocity
   double max_speed = 0;           // largest particle speed, maintained by the scheme's gather
   int external_force = -1;        // particle field handle, or -1 if no load uses it
-  int initial_position = -1;      // for displacement output, or -1
   bool model_checked = false;     // grid and plugins were set up (output checks may run)
   /// Set by a plugin that cannot continue (e.g. "particle 12: CPDI domain inverted"); the runner
   /// stops with exit code 3 after the current step, naming step and time.
