@@ -34,6 +34,10 @@ class Material {
   virtual double density() const = 0;
   /// Request state fields; `index` is this material's index in particles.material.
   virtual void setup(Simulation<D>&, int /*index*/, Diagnostics&) {}
+  /// Set state fields of particles [begin, end) from their current (initial) stress, e.g. the
+  /// preconsolidation pressure from an OCR. Called once after set-up and whenever a driver (the
+  /// element test) imposes a new initial stress.
+  virtual void initialize(Particles<D>&, size_t /*begin*/, size_t /*end*/) {}
   /// Largest P-wave speed (m/s) of particles [begin, end) for the CFL time step.
   virtual double wave_speed(const Particles<D>& p, size_t begin, size_t end) const = 0;
   virtual void update_stress(const MaterialBatch<D>& batch) = 0;

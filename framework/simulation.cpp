@@ -51,6 +51,10 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
     external_force = particles.request(
         {"external_force", D, "N", "applied external force", Particles<D>::axis_names()});
   sort();
+  for (size_t m = 0; m < materials.size(); ++m) {
+    const auto& r = partition.material_ranges[m];
+    if (r.end > r.begin) materials[m]->initialize(particles, r.begin, r.end);
+  }
   for (auto& b : boundaries) b->setup(*this, diag);
   model_checked = true;
   if (!particles_ok) return;  // loads and references select particles
