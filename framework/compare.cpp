@@ -3,7 +3,6 @@
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
-#include <sys/wait.h>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -16,6 +15,7 @@
 
 #include "diagnostics.hpp"
 #include "params.hpp"
+#include "process.hpp"
 
 namespace fs = std::filesystem;
 
@@ -58,23 +58,6 @@ std::string csv_field(const std::string& s) {
   std::string q = "\"";
   for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
   return q + "\"";
-}
-
-/// Run a command, capturing stdout+stderr; returns the exit code.
-int run_command(const std::string& cmd, std::string& output) {
-  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-  if (!pipe) return -1;
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof buf, pipe)) output.append(buf, n);
-  int status = pclose(pipe);
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
-}
-
-std::string shell_quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
 }
 
 bool load_summary(const fs::path& file, nlohmann::json& out) {
@@ -271,8 +254,7 @@ int run_compare(const CompareOptions& opt) {
   // The plot is optional: the CSV above is the result; the PNG needs python3 + matplotlib.
   std::string metric = p.has("metric") ? p.text("metric") : "";
   std::string series = p.has("series") ? p.text("series") : axes.empty() ? "" : axes[0].path;
-  // Debian's interpreter has python3-matplotlib (tools/setup.sh); a pyenv python3 may not.
-  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  const std::string python = python_interpreter();
   std::string plot = python + " " + shell_quote(std::string(LOAM_TOOLS_DIR) + "/pareto.py") + " " +
                      shell_quote((out / "compare.csv").string()) + " --out " +
                      shell_quote((out / "pareto.png").string()) + " --series " +

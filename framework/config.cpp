@@ -193,18 +193,16 @@ int detect_dimension(const YAML::Node& root) {
   return 0;
 }
 
-LoadedConfig validate_tree(YAML::Node root, const std::string& file,
-                           const std::vector<std::string>& overrides, Diagnostics& diag) {
-  LoadedConfig out;
-  out.file = file;
-  out.name = std::filesystem::path(file).stem().string();
-  ValidationContext ctx;
+/// Overrides and out-of-tree plugin libraries: what every YAML input file gets before
+/// validation. Returns false if the root is not a map (reported).
+bool prepare_tree(YAML::Node& root, const std::string& file,
+                  const std::vector<std::string>& overrides, ValidationContext& ctx,
+                  Diagnostics& diag, const char* not_a_map) {
   ctx.file = file;
   if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap()) {
-    diag.error(Location{file, root.Mark().line + 1, root.Mark().column + 1}, "",
-               "a run file must be a map of keys (grid, bodies, time, ...)");
-    return out;
+    diag.error(Location{file, root.Mark().line + 1, root.Mark().column + 1}, "", not_a_map);
+    return false;
   }
   for (size_t i = 0; i < overrides.size(); ++i) {
     std::string label = "<--set " + overrides[i] + ">", path;
@@ -226,6 +224,18 @@ LoadedConfig validate_tree(YAML::Node root, const std::string& file,
       std::string err = load_plugin_library(lib.string());
       if (!err.empty()) diag.error(loc, where, err);
     }
+  return true;
+}
+
+LoadedConfig validate_tree(YAML::Node root, const std::string& file,
+                           const std::vector<std::string>& overrides, Diagnostics& diag) {
+  LoadedConfig out;
+  out.file = file;
+  out.name = std::filesystem::path(file).stem().string();
+  ValidationContext ctx;
+  if (!prepare_tree(root, file, overrides, ctx, diag,
+                    "a run file must be a map of keys (grid, bodies, time, ...)"))
+    return out;
   out.dimension = detect_dimension(root);
   ctx.dimension = out.dimension ? out.dimension : 2;
   if (!out.dimension && root["grid"] && root["grid"].IsMap() && root["grid"]["extent"] &&
@@ -265,21 +275,52 @@ LoadedConfig load_config_text(const std::string& text, const std::string& label,
   return validate_tree(root, label, overrides, diag);
 }
 
-LoadedConfig load_config(const std::string& file, const std::vector<std::string>& overrides,
-                         Diagnostics& diag) {
+namespace {
+
+/// The text of a file, or "" with an error in diag.
+bool read_file(const std::string& file, const char* what, std::string& text, Diagnostics& diag) {
   std::ifstream in(file);
   if (!in) {
-    diag.error(
-        Location{file, 1, 1}, "",
-        "cannot open the run file: " +
-            std::string(std::filesystem::exists(file) ? "permission denied" : "no such file"));
+    diag.error(Location{file, 1, 1}, "",
+               std::string("cannot open the ") + what + ": " +
+                   (std::filesystem::exists(file) ? "permission denied" : "no such file"));
+    return false;
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  text = ss.str();
+  return true;
+}
+
+}  // namespace
+
+Params load_yaml_file(const std::string& file, const std::vector<std::string>& overrides,
+                      const Schema& schema, int dimension, Diagnostics& diag) {
+  std::string text;
+  if (!read_file(file, "input file", text, diag)) return {};
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    diag.error(parse_error_location(e, file), "", "malformed YAML: " + yaml_message(e));
+    return {};
+  }
+  ValidationContext ctx;
+  ctx.dimension = dimension;
+  if (!prepare_tree(root, file, overrides, ctx, diag, "the input file must be a map of keys"))
+    return {};
+  return validate(root, schema, "", Location{file, 1, 1}, ctx, diag);
+}
+
+LoadedConfig load_config(const std::string& file, const std::vector<std::string>& overrides,
+                         Diagnostics& diag) {
+  std::string text;
+  if (!read_file(file, "run file", text, diag)) {
     LoadedConfig out;
     out.file = file;
     return out;
   }
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return load_config_text(ss.str(), file, overrides, diag);
+  return load_config_text(text, file, overrides, diag);
 }
 
 }  // namespace loam

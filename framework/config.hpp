@@ -26,4 +26,9 @@ LoadedConfig load_config(const std::string& file, const std::vector<std::string>
 LoadedConfig load_config_text(const std::string& text, const std::string& label,
                               const std::vector<std::string>& overrides, Diagnostics& diag);
 
+/// Read any YAML input file (e.g. an element test), apply --set overrides, load its `plugins:`
+/// libraries and validate it against `schema` for a fixed dimension.
+Params load_yaml_file(const std::string& file, const std::vector<std::string>& overrides,
+                      const Schema& schema, int dimension, Diagnostics& diag);
+
 }  // namespace loam

@@ -10,6 +10,7 @@
 // update_stress). Stress-controlled components (the confining stress of a drained triaxial
 // test, the normal stress of simple shear) are met by a Newton iteration on the unknown strain
 // increments with a finite-difference Jacobian, to 1e-10 of the stress scale.
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -79,5 +80,16 @@ struct ElementTestConfig {
 };
 ElementTestConfig load_element_test(const std::string& file,
                                     const std::vector<std::string>& overrides, Diagnostics& diag);
+
+struct ElementTestOptions {
+  std::vector<std::string> overrides;
+  std::string out_dir;  // default results/<file stem>
+  bool overwrite = false;
+  bool quiet = false;
+};
+
+/// `loam element-test FILE`: validate, run, write OUT/<stem>.csv and (python3 + matplotlib)
+/// OUT/<stem>.png. Returns the exit code: 0 ok, 2 bad input, 3 the test stopped early.
+int run_element_test_file(const std::string& file, const ElementTestOptions& options);
 
 }  // namespace loam

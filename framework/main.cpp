@@ -1,4 +1,4 @@
-// The `loam` command line: run, check, plugins, schema, bench.
+// The `loam` command line: run, check, element-test, plugins, schema, compare, bench.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -8,6 +8,7 @@
 #include "compare.hpp"
 #include "config.hpp"
 #include "docs.hpp"
+#include "element_test.hpp"
 #include "runner.hpp"
 
 int main(int argc, char** argv) {
@@ -34,6 +35,17 @@ int main(int argc, char** argv) {
   check->add_option("config", check_file, "run file (YAML)")->required();
   check->add_option("--set", check_sets, "override a key: path.to.key=value")
       ->allow_extra_args(false);
+
+  loam::ElementTestOptions et_opt;
+  std::string et_file;
+  auto* element = app.add_subcommand(
+      "element-test", "drive one material point along a laboratory path; write CSV and PNG");
+  element->add_option("config", et_file, "element-test file (YAML: material, test)")->required();
+  element->add_option("--set", et_opt.overrides, "override a key: path.to.key=value")
+      ->allow_extra_args(false);
+  element->add_option("--out", et_opt.out_dir, "output directory (default results/<file name>)");
+  element->add_flag("--overwrite", et_opt.overwrite, "replace the results in the directory");
+  element->add_flag("--quiet", et_opt.quiet, "no progress lines");
 
   std::string kind;
   bool markdown = false;
@@ -109,6 +121,10 @@ int main(int argc, char** argv) {
   if (*schema) {
     fputs(loam::print_config_schema(schema_md).c_str(), stdout);
     return 0;
+  }
+  if (*element) {
+    if (et_opt.quiet) spdlog::set_level(spdlog::level::warn);
+    return loam::run_element_test_file(et_file, et_opt);
   }
   if (*bench) return loam::run_bench(bench_opt);
   if (*compare) return loam::run_compare(cmp_opt);
