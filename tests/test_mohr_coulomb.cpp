@@ -353,18 +353,23 @@ TEST_CASE("mohr_coulomb: bad parameters give the located error", "[material][uni
     std::string params, line;
   };
   const std::vector<Case> cases = {
-      {"c: 1000, phi: 30, psi: 35",
+      {"nu: 0.3, c: 1000, phi: 30, psi: 35",
        ":7:93: error: bodies.0.material.psi: dilation angle psi = 35 must not exceed the "
        "friction angle phi = 30"},
-      {"c: 1000, phi: 90, psi: 0",
+      {"nu: 0.3, c: 1000, phi: 90, psi: 0",
        ":7:84: error: bodies.0.material.phi: 90 is out of range [0, 90) deg"},
-      {"c: -1, phi: 30, psi: 0",
+      {"nu: 0.3, c: -1, phi: 30, psi: 0",
        ":7:73: error: bodies.0.material.c: -1 is out of range [0, inf) Pa"},
+      // Soil models take nu in [0, 0.5): a negative Poisson's ratio is rejected.
+      {"nu: -0.1, c: 1000, phi: 30, psi: 0",
+       ":7:65: error: bodies.0.material.nu: -0.1 is out of range [0, 0.5)"},
+      {"nu: 0.5, c: 1000, phi: 30, psi: 0",
+       ":7:65: error: bodies.0.material.nu: 0.5 is out of range [0, 0.5)"},
   };
   for (const auto& k : cases) {
     std::ofstream(cfg) << "grid:\n  extent: [4]\n  cell_size: 1\nbodies:\n  - name: bar\n"
                           "    generator: {type: box, min: [0], max: [2]}\n"
-                          "    material: {type: mohr_coulomb, E: 1.0e6, nu: 0.3, density: 2000, "
+                          "    material: {type: mohr_coulomb, E: 1.0e6, density: 2000, "
                        << k.params << "}\ntime:\n  end: 0.1\n";
     auto r = loam_test::run_loam("run " + cfg.string() + " --quiet --out " +
                                  (dir.path / "out").string());
