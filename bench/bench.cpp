@@ -56,6 +56,7 @@ boundaries:
 int run_scene(const BenchOptions& opt, const std::string& scene, const std::string& shape);
 
 int run_bench(const BenchOptions& opt) {
+  if (!opt.materials.empty()) return run_material_bench(opt);
   int status = 0;
   std::vector<std::string> shapes = opt.shapes;
   if (shapes.size() == 1 && shapes[0] == "all")

@@ -21,6 +21,13 @@ class Boundary {
   virtual void setup(Simulation<D>&, Diagnostics&) {}
   /// Zero the constrained components of `v` (a velocity, momentum, acceleration or force).
   virtual void constrain(const NodalVector& v) const = 0;
+  /// Constrain the velocity v^{n+1} and acceleration a of a grid update together (v^{n+1} =
+  /// v^n + dt a). A condition that depends on the motion (Coulomb friction, contact) overrides
+  /// this and keeps a consistent with the velocity it imposes, so FLIP particles see it too.
+  virtual void constrain_update(const NodalVector& v, const NodalVector& a, double /*dt*/) const {
+    constrain(v);
+    constrain(a);
+  }
 };
 
 /// The nodes on one face of the grid ("x-", "x+", "y-", ...), for face-based plugins.

@@ -94,6 +94,8 @@ class Point {
     if (!diag.ok()) throw std::logic_error("element test: " + diag.format());
     sim_->materials[0] = Registry::instance().create<Material, 3>(material);
     auto& P = sim_->particles;
+    // The mass follows the tested material's density (density-dependent models read m / V).
+    P.col(P.mass)[0] = P.col(P.volume)[0] * sim_->materials[0]->density();
     sim_->materials[0]->setup(*sim_, 0, diag);
     if (!diag.ok()) throw std::runtime_error(diag.format());
     for (int c = 0; c < 6; ++c) P.col(P.stress, c)[0] = c < 3 ? -confining : 0.0;

@@ -83,6 +83,9 @@ int main(int argc, char** argv) {
   bench->add_option("--repeat", bench_opt.repeat, "repeat each run and report the median")
       ->check(CLI::Range(1, 20));
   bench->add_flag("--profile", bench_opt.profile, "print where the step's time goes");
+  bench->add_option("--materials", bench_opt.materials,
+                    "instead of scenes: stress-update cost per particle of each material "
+                    "(all, or one material name)");
 
   try {
     app.parse(argc, argv);

@@ -94,6 +94,10 @@ class Simulation {
   void constrain(const NodalVector& v) const {
     for (const auto& b : boundaries) b->constrain(v);
   }
+  /// Apply every boundary condition to the updated nodal velocity and acceleration.
+  void constrain_update(const NodalVector& v, const NodalVector& a, double dt) const {
+    for (const auto& b : boundaries) b->constrain_update(v, a, dt);
+  }
   void apply_grid_loads(const NodalVector& force) {
     for (const auto& l : loads) l->apply_to_grid(*this, force, time);
   }

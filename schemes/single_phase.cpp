@@ -165,8 +165,7 @@ class SinglePhase : public Scheme<D> {
         for (int d = 0; d < 2 * D; ++d) r[1 + d] = 0.0;
       }
     }
-    sim.constrain(node_vector(1));
-    sim.constrain(node_vector(1 + D));
+    sim.constrain_update(node_vector(1), node_vector(1 + D), dt);
   }
 
   /// Velocity from momentum in vel_ (MUSL re-map, USF), constrained.

@@ -175,3 +175,21 @@ TEST_CASE("element-test: bad input gives every located error at once, exit code 
                       "isotropic paths, not simple_shear") != std::string::npos);
   CHECK_FALSE(std::filesystem::exists(out));
 }
+
+TEST_CASE("element-test: the particle mass follows the tested material's density",
+          "[element_test][unit]") {
+  // newtonian_fluid reads its pressure from m / V: an isotropic compression by eps_v gives
+  // p = K (rho/rho0 - 1) = K (V0/V - 1) with V/V0 = prod(1 - eps_v/3/n)^(3n) (det(I + L dt)
+  // per increment, the scheme's volume update). Hand value to 1e-9.
+  auto t = path("isotropic", 1e-3, 10);
+  t.confining = 0;
+  auto r = loam::run_element_test(
+      "{type: newtonian_fluid, bulk_modulus: 2.0e6, viscosity: 0, density: 1000}", t);
+  REQUIRE(r.failure.empty());
+  const double ratio = std::pow(1 - 1e-3 / 3 / 10, 3 * 10);
+  const double expected = 2.0e6 * (1 / ratio - 1);
+  const double err = rel(r.at(-1, "p"), expected);
+  std::printf("fluid through the driver: p = %.6f Pa (hand %.6f), error %.2e\n", r.at(-1, "p"),
+              expected, err);
+  CHECK(err < 1e-9);
+}
