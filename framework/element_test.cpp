@@ -135,6 +135,15 @@ class Point {
         F(i, j) += L[size_t(i)][size_t(j)] * dt;
       }
     P.col(P.volume)[0] *= F.determinant();
+    // F^{n+1} = (I + L dt) F^n, as the schemes do when a material requested F.
+    if (const int h = P.find("deformation_gradient"); h >= 0) {
+      Eigen::Matrix3d Fn;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) Fn(i, j) = P.col(h, i * 3 + j)[0];
+      const Eigen::Matrix3d Fnew = F * Fn;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) P.col(h, i * 3 + j)[0] = Fnew(i, j);
+    }
     batch_.dt = dt;
     sim_->materials[0]->update_stress(batch_);
   }
