@@ -42,7 +42,7 @@ def main():
     ax[1].set_xlabel("p' (kPa)")
     ax[1].set_ylabel("q (kPa)")
     if a.q_peak is not None:
-        ax[0].axhline(a.q_peak / 1e3, color="tab:red", ls="--", label="analytic peak")
+        ax[0].axhline(a.q_peak / 1e3, color="tab:red", ls="--", label="analytic q")
         ax[0].legend(fontsize=8)
     if a.M is not None:
         pm = max(p)
@@ -50,7 +50,10 @@ def main():
         ax[1].legend(fontsize=8)
     if has_e:
         ax[2].semilogx(p, e, "k-")
-        ax[2].xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax[2].xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+        if max(p) < 10 * min(p):  # less than a decade: label the minor ticks, small
+            ax[2].xaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+            ax[2].tick_params(axis="x", which="minor", labelsize=7)
         ax[2].set_xlabel("p' (kPa, log)")
         ax[2].set_ylabel("void ratio e")
     for x in ax:
