@@ -1,10 +1,12 @@
 #pragma once
 // Helpers for tests that run the real `loam` command line (regression scenes).
+#include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace loam_test {
 
@@ -43,6 +45,33 @@ inline nlohmann::json run_scene(const std::string& config, const std::filesystem
   if (r.exit_code != 0) throw std::runtime_error("loam run " + config + " failed:\n" + r.output);
   std::ifstream in(out / "summary.json");
   return nlohmann::json::parse(in);
+}
+
+/// A bad material parameter set and the one error line `loam run` must print for it.
+struct BadMaterial {
+  std::string params;  // appended to the material map
+  std::string line;    // the output after the config path: ":7:COL: error: key.path: message"
+};
+
+/// For each case, write run.yaml with one 1D body `body` whose line 7 is
+/// `    material: {<material><params>}`, run `loam run` on it and check exit code 2, that the
+/// output is exactly the one line <config path><line>, and that no output directory was made.
+inline void check_bad_material(const std::string& material, const std::vector<BadMaterial>& cases,
+                               const std::string& body = "bar") {
+  TempDir dir("bad_material");
+  std::filesystem::create_directories(dir.path);
+  const auto cfg = dir.path / "run.yaml";
+  for (const auto& k : cases) {
+    std::ofstream(cfg) << "grid:\n  extent: [4]\n  cell_size: 1\nbodies:\n  - name: " << body
+                       << "\n    generator: {type: box, min: [0], max: [2]}\n"
+                          "    material: {"
+                       << material << k.params << "}\ntime:\n  end: 0.1\n";
+    auto r = run_loam("run " + cfg.string() + " --quiet --out " + (dir.path / "out").string());
+    std::printf("%s", r.output.c_str());
+    CHECK(r.exit_code == 2);
+    CHECK(r.output == cfg.string() + k.line + "\n");  // exactly this one line (column: value)
+    CHECK_FALSE(std::filesystem::exists(dir.path / "out"));
+  }
 }
 
 }  // namespace loam_test

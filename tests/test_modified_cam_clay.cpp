@@ -5,16 +5,13 @@
 // material itself stores tension-positive Cauchy stress.
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <fstream>
 #include <random>
 #include <vector>
 
 #include "cli.hpp"
 #include "framework/element_test.hpp"
 #include "framework/tensor.hpp"
-#include "sim_helpers.hpp"
-
-using loam_test::make_simulation;
+#include "material_point.hpp"
 
 namespace {
 
@@ -73,59 +70,24 @@ double e_lnp_slope(const loam::ElementTestResult& r, size_t from, size_t to) {
   return (n * sxy - sx * sy) / (n * sxx - sx * sx);
 }
 
-std::string sim_config(int dim, const std::string& material) {
-  std::string ext = dim == 3 ? "[1, 1, 1]" : dim == 2 ? "[1, 1]" : "[1]";
-  std::string lo = dim == 3 ? "[0.25, 0.25, 0.25]" : dim == 2 ? "[0.25, 0.25]" : "[0.25]";
-  std::string hi = dim == 3 ? "[0.5, 0.5, 0.5]" : dim == 2 ? "[0.5, 0.5]" : "[0.5]";
-  return "grid: {extent: " + ext +
-         ", cell_size: 0.25}\nshape_function: linear\nbodies:\n"
-         "  - name: soil\n    generator: {type: box, min: " +
-         lo + ", max: " + hi + "}\n    material: " + material + "\ntime: {end: 1}\n";
-}
-
 /// One material point (the first particle) strain-driven through MaterialBatch with dt = 1.
 template <int D>
-struct Point {
-  static constexpr int NS = loam::Particles<D>::NS;
-  std::unique_ptr<loam::Simulation<D>> sim;
-  std::vector<double> L = std::vector<double>(size_t(D * D) * loam::kBlock, 0.0);
-  loam::MaterialBatch<D> batch;
-  int e_field, pc_field;
+struct Point : loam_test::MaterialPoint<D> {
+  int e_field = this->handle("void_ratio"), pc_field = this->handle("preconsolidation_pressure");
 
   explicit Point(const std::string& material = mcc(", pc0: 100e3"))
-      : sim(make_simulation<D>(sim_config(D, material))) {
-    auto& P = sim->particles;
-    batch.begin = 0;
-    batch.count = 1;
-    batch.L = L.data();
-    batch.particles = &P;
-    batch.dt = 1.0;
-    e_field = P.find("void_ratio");
-    pc_field = P.find("preconsolidation_pressure");
-  }
-  double& stress(int c) { return sim->particles.col(sim->particles.stress, c)[0]; }
-  double& pc() { return sim->particles.col(pc_field)[0]; }
-  double& e() { return sim->particles.col(e_field)[0]; }
+      : loam_test::MaterialPoint<D>(material) {}
+  double& pc() { return this->field(pc_field); }
+  double& e() { return this->field(e_field); }
   /// Impose a stress (tension positive Voigt, NS components) and re-initialize the state.
   void set(const std::vector<double>& s) {
-    for (int k = 0; k < NS; ++k) stress(k) = s[size_t(k)];
-    sim->materials[0]->initialize(sim->particles, 0, 1);
+    for (int k = 0; k < Point::NS; ++k) this->stress(k) = s[size_t(k)];
+    this->sim->materials[0]->initialize(this->sim->particles, 0, 1);
   }
-  void step(const std::vector<double>& l) {
-    for (int k = 0; k < D * D; ++k) L[size_t(k) * loam::kBlock] = l[size_t(k)];
-    sim->materials[0]->update_stress(batch);
+  double f_rel() {
+    const double p = this->p(), q = this->q();
+    return (q * q / (kM * kM) + p * (p - pc())) / (pc() * pc());
   }
-  double p() { return -(stress(0) + stress(1) + stress(2)) / 3; }
-  double q() {
-    double v[6] = {0, 0, 0, 0, 0, 0};
-    for (int k = 0; k < NS; ++k) v[k] = stress(k);
-    const double m = -p();
-    const double j2 =
-        0.5 * ((v[0] - m) * (v[0] - m) + (v[1] - m) * (v[1] - m) + (v[2] - m) * (v[2] - m)) +
-        v[3] * v[3] + v[4] * v[4] + v[5] * v[5];
-    return std::sqrt(3 * j2);
-  }
-  double f_rel() { return (q() * q() / (kM * kM) + p() * (p() - pc())) / (pc() * pc()); }
 };
 
 }  // namespace
@@ -555,15 +517,9 @@ TEST_CASE("modified_cam_clay: initial state, min_pressure and wave speed", "[mat
 }
 
 TEST_CASE("modified_cam_clay: bad parameters give the located error", "[material][unit]") {
-  loam_test::TempDir dir("modified_cam_clay_bad");
-  std::filesystem::create_directories(dir.path);
-  const auto cfg = dir.path / "run.yaml";
-  struct Case {
-    std::string params, line;
-  };
   // Each error is located at the offending value (column of the value in line 7), a missing
   // alternative at the material map itself (column 15).
-  const std::vector<Case> cases = {
+  const std::vector<loam_test::BadMaterial> cases = {
       {"lambda: 0.1, kappa: 0.1, M: 1.2, nu: 0.3",
        ":7:91: error: bodies.0.material.kappa: swelling slope kappa = 0.1 must be smaller than "
        "the compression slope lambda = 0.1"},
@@ -578,16 +534,5 @@ TEST_CASE("modified_cam_clay: bad parameters give the located error", "[material
       {"lambda: 0.2, kappa: 0.04, M: 1.2",
        ":7:15: error: bodies.0.material: give exactly one of 'nu' or 'G'"},
   };
-  for (const auto& k : cases) {
-    std::ofstream(cfg) << "grid:\n  extent: [4]\n  cell_size: 1\nbodies:\n  - name: bar\n"
-                          "    generator: {type: box, min: [0], max: [2]}\n"
-                          "    material: {type: modified_cam_clay, e0: 1, ocr: 1, density: 1800, "
-                       << k.params << "}\ntime:\n  end: 0.1\n";
-    auto r = loam_test::run_loam("run " + cfg.string() + " --quiet --out " +
-                                 (dir.path / "out").string());
-    std::printf("%s", r.output.c_str());
-    CHECK(r.exit_code == 2);
-    CHECK(r.output == cfg.string() + k.line + "\n");  // exactly this one line (column: value)
-    CHECK_FALSE(std::filesystem::exists(dir.path / "out"));
-  }
+  loam_test::check_bad_material("type: modified_cam_clay, e0: 1, ocr: 1, density: 1800, ", cases);
 }

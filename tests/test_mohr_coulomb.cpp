@@ -4,33 +4,23 @@
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <fstream>
 #include <random>
 #include <vector>
 
 #include "cli.hpp"
 #include "framework/tensor.hpp"
-#include "sim_helpers.hpp"
-
-using loam_test::make_simulation;
+#include "material_point.hpp"
 
 namespace {
 
 constexpr double kE = 20e6, kNu = 0.3, kC = 10e3, kPhi = 30, kPsi = 10;
 
-std::string mc_config(int dim, double c = kC, double phi = kPhi, double psi = kPsi,
-                      const std::string& extra = "") {
-  std::string ext = dim == 3 ? "[1, 1, 1]" : dim == 2 ? "[1, 1]" : "[1]";
-  std::string lo = dim == 3 ? "[0.25, 0.25, 0.25]" : dim == 2 ? "[0.25, 0.25]" : "[0.25]";
-  std::string hi = dim == 3 ? "[0.5, 0.5, 0.5]" : dim == 2 ? "[0.5, 0.5]" : "[0.5]";
+std::string mc(double c = kC, double phi = kPhi, double psi = kPsi, const std::string& extra = "") {
   char mat[256];
   std::snprintf(mat, sizeof mat,
                 "{type: mohr_coulomb, E: %g, nu: %g, density: 2000, c: %g, phi: %g, psi: %g%s}", kE,
                 kNu, c, phi, psi, extra.c_str());
-  return "grid: {extent: " + ext +
-         ", cell_size: 0.25}\nshape_function: linear\nbodies:\n"
-         "  - name: soil\n    generator: {type: box, min: " +
-         lo + ", max: " + hi + "}\n    material: " + mat + "\ntime: {end: 1}\n";
+  return mat;
 }
 
 double rad(double deg) {
@@ -39,51 +29,17 @@ double rad(double deg) {
 
 /// One material point of the first particle, strain-driven with L = diag/offdiag increments.
 template <int D>
-struct Point {
-  static constexpr int NS = loam::Particles<D>::NS;
-  std::unique_ptr<loam::Simulation<D>> sim;
-  std::vector<double> L = std::vector<double>(size_t(D * D) * loam::kBlock, 0.0);
-  loam::MaterialBatch<D> batch;
-  int eq = -1;
+struct Point : loam_test::MaterialPoint<D> {
   double phi, psi, c;
+  int eq = this->handle("plastic_strain_eq");
 
-  explicit Point(double c_ = kC, double phi_ = kPhi, double psi_ = kPsi)
-      : sim(make_simulation<D>(mc_config(D, c_, phi_, psi_))), phi(phi_), psi(psi_), c(c_) {
-    auto& P = sim->particles;
-    batch.begin = 0;
-    batch.count = 1;
-    batch.L = L.data();
-    batch.particles = &P;
-    batch.dt = 1.0;
-    eq = P.find("plastic_strain_eq");
-  }
-  double& stress(int c_) { return sim->particles.col(sim->particles.stress, c_)[0]; }
-  double& eqps() { return sim->particles.col(eq)[0]; }
-  void isotropic(double s) {
-    for (int k = 0; k < NS; ++k) stress(k) = k < 3 ? s : 0.0;
-  }
-  /// Apply the strain increment de (D x D, row-major; L = de with dt = 1).
-  void step(const std::vector<double>& de) {
-    for (int k = 0; k < D * D; ++k) L[size_t(k) * loam::kBlock] = de[size_t(k)];
-    sim->materials[0]->update_stress(batch);
-  }
-  std::vector<double> save() {
-    std::vector<double> s(NS + 1);
-    for (int k = 0; k < NS; ++k) s[size_t(k)] = stress(k);
-    s[NS] = eqps();
-    return s;
-  }
-  void restore(const std::vector<double>& s) {
-    for (int k = 0; k < NS; ++k) stress(k) = s[size_t(k)];
-    eqps() = s[NS];
-  }
+  explicit Point(double c_ = kC, double phi_ = kPhi, double psi_ = kPsi,
+                 const std::string& extra = "")
+      : loam_test::MaterialPoint<D>(mc(c_, phi_, psi_, extra)), phi(phi_), psi(psi_), c(c_) {}
+  double& eqps() { return this->field(eq); }
   /// Mohr-Coulomb yield value (tension positive) and a stress scale.
   std::pair<double, double> yield() {
-    Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
-    double v[6] = {0, 0, 0, 0, 0, 0};  // 1D and 2D store fewer components
-    for (int k = 0; k < NS; ++k) v[k] = stress(k);
-    m << v[0], v[3], v[5], v[3], v[1], v[4], v[5], v[4], v[2];
-    Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(m).eigenvalues();
+    const Eigen::Vector3d ev = this->principal_stress();
     const double s1 = ev[2], s3 = ev[0];
     const double sp = std::sin(rad(phi)), cp = std::cos(rad(phi));
     return {(s1 - s3) + (s1 + s3) * sp - 2 * c * cp, 2 * c * cp + ev.cwiseAbs().maxCoeff()};
@@ -110,22 +66,7 @@ PathResult drained_compression(Point<D>& pt, double s3, double strain, int n) {
   const double da = strain / n;
   double last_dv = 0, last_d1 = 0, last_d3 = 0;
   for (int i = 0; i < n; ++i) {
-    const auto saved = pt.save();
-    auto run = [&](double e) {
-      pt.restore(saved);
-      std::vector<double> de(size_t(D * D), 0.0);
-      de[0] = -da;
-      for (int k = 1; k < D; ++k) de[size_t(k * D + k)] = e;
-      pt.step(de);
-      return pt.stress(1) + s3;
-    };
-    double e0 = kNu * da, e1 = 2 * kNu * da;
-    double r0 = run(e0), r1 = run(e1);
-    for (int it = 0; it < 60 && std::fabs(r1) > 1e-10 * s3; ++it) {
-      const double e2 = e1 - r1 * (e1 - e0) / (r1 - r0);
-      e0 = e1, r0 = r1, e1 = e2, r1 = run(e1);
-    }
-    REQUIRE(std::fabs(r1) <= 1e-9 * s3);
+    const double e1 = pt.compress_at_lateral_stress(da, s3, kNu);
     r.peak = std::max(r.peak, -pt.stress(0));
     auto [f, scale] = pt.yield();
     r.worst_f = std::max(r.worst_f, f / scale);
@@ -229,19 +170,12 @@ TEST_CASE("mohr_coulomb: yield function is satisfied after every return on a ran
 }
 
 TEST_CASE("mohr_coulomb: tension cutoff caps the largest principal stress", "[material][unit]") {
-  auto sim = make_simulation<3>(mc_config(3, kC, kPhi, kPsi, ", tension_cutoff: 2000"));
-  Point<3> pt;
-  pt.sim = std::move(sim);
-  pt.batch.particles = &pt.sim->particles;
-  pt.eq = pt.sim->particles.find("plastic_strain_eq");
+  Point<3> pt(kC, kPhi, kPsi, ", tension_cutoff: 2000");
   pt.isotropic(0);
   double worst = 0;
   for (int i = 0; i < 50; ++i) {
     pt.step({2e-4, 0, 0, 0, -5e-5, 0, 0, 0, 0});  // stretch x, squeeze y
-    Eigen::Matrix3d m;
-    m << pt.stress(0), pt.stress(3), pt.stress(5), pt.stress(3), pt.stress(1), pt.stress(4),
-        pt.stress(5), pt.stress(4), pt.stress(2);
-    const double s1 = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(m).eigenvalues()[2];
+    const double s1 = pt.principal_stress()[2];
     worst = std::max(worst, s1 - 2000);
     auto [f, scale] = pt.yield();
     worst = std::max(worst, f / scale * 1e3);
@@ -346,13 +280,7 @@ TEST_CASE("mohr_coulomb: a rigid rotation of a stressed point keeps its invarian
 }
 
 TEST_CASE("mohr_coulomb: bad parameters give the located error", "[material][unit]") {
-  loam_test::TempDir dir("mohr_coulomb_bad");
-  std::filesystem::create_directories(dir.path);
-  const auto cfg = dir.path / "run.yaml";
-  struct Case {
-    std::string params, line;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<loam_test::BadMaterial> cases = {
       {"nu: 0.3, c: 1000, phi: 30, psi: 35",
        ":7:93: error: bodies.0.material.psi: dilation angle psi = 35 must not exceed the "
        "friction angle phi = 30"},
@@ -366,16 +294,5 @@ TEST_CASE("mohr_coulomb: bad parameters give the located error", "[material][uni
       {"nu: 0.5, c: 1000, phi: 30, psi: 0",
        ":7:65: error: bodies.0.material.nu: 0.5 is out of range [0, 0.5)"},
   };
-  for (const auto& k : cases) {
-    std::ofstream(cfg) << "grid:\n  extent: [4]\n  cell_size: 1\nbodies:\n  - name: bar\n"
-                          "    generator: {type: box, min: [0], max: [2]}\n"
-                          "    material: {type: mohr_coulomb, E: 1.0e6, density: 2000, "
-                       << k.params << "}\ntime:\n  end: 0.1\n";
-    auto r = loam_test::run_loam("run " + cfg.string() + " --quiet --out " +
-                                 (dir.path / "out").string());
-    std::printf("%s", r.output.c_str());
-    CHECK(r.exit_code == 2);
-    CHECK(r.output == cfg.string() + k.line + "\n");  // exactly this one line (column: value)
-    CHECK_FALSE(std::filesystem::exists(dir.path / "out"));
-  }
+  loam_test::check_bad_material("type: mohr_coulomb, E: 1.0e6, density: 2000, ", cases);
 }

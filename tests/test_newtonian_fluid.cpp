@@ -1,15 +1,15 @@
-// Unit tests of the newtonian_fluid material at one material point: a local harness that does
-// what a scheme does (V *= det(I + L dt), then update_stress with the rate L and dt) in 1D, 2D
-// and 3D, the element-test driver (3D paths), and its parameter checks through the command
-// line. The material is tension positive; p is compression positive.
+// Unit tests of the newtonian_fluid material at one material point: the material-point harness
+// (material_point.hpp) doing what a scheme does (V *= det(I + L dt), then update_stress with the
+// rate L and dt) in 1D, 2D and 3D, the element-test driver (3D paths), and its parameter checks
+// through the command line. The material is tension positive; p is compression positive.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <vector>
 
 #include "cli.hpp"
 #include "framework/element_test.hpp"
+#include "material_point.hpp"
 #include "sim_helpers.hpp"
 
 using loam_test::make_simulation;
@@ -26,56 +26,12 @@ std::string fluid(double mu = kMu, const std::string& extra = "") {
   return m;
 }
 
-std::string config(int dim, const std::string& material) {
-  std::string ext = dim == 3 ? "[1, 1, 1]" : dim == 2 ? "[1, 1]" : "[1]";
-  std::string lo = dim == 3 ? "[0.25, 0.25, 0.25]" : dim == 2 ? "[0.25, 0.25]" : "[0.25]";
-  std::string hi = dim == 3 ? "[0.5, 0.5, 0.5]" : dim == 2 ? "[0.5, 0.5]" : "[0.5]";
-  return "grid: {extent: " + ext +
-         ", cell_size: 0.25}\nshape_function: linear\nbodies:\n"
-         "  - name: water\n    generator: {type: box, min: " +
-         lo + ", max: " + hi + "}\n    material: " + material + "\ntime: {end: 1}\n";
-}
-
-/// The first particle of a one-material simulation, stepped as a scheme steps it.
+/// The first particle of a one-material simulation, stepped as a scheme steps it:
+/// V *= det(I + L dt) (or exp(tr(L) dt) with VolumeUpdate::exp), then update_stress.
 template <int D>
-struct Point {
-  static constexpr int NS = loam::Particles<D>::NS;
-  std::unique_ptr<loam::Simulation<D>> sim;
-  std::vector<double> L = std::vector<double>(size_t(D * D) * loam::kBlock, 0.0);
-  loam::MaterialBatch<D> batch;
-  bool exact_volume = false;  // V *= exp(tr(L) dt) instead of the schemes' det(I + L dt)
-
-  explicit Point(const std::string& material) : sim(make_simulation<D>(config(D, material))) {
-    batch.begin = 0;
-    batch.count = 1;
-    batch.L = L.data();
-    batch.particles = &sim->particles;
-  }
-  double& stress(int c) { return sim->particles.col(sim->particles.stress, c)[0]; }
-  double& volume() { return sim->particles.col(sim->particles.volume)[0]; }
-  double mass() { return sim->particles.col(sim->particles.mass)[0]; }
-  double rho() { return mass() / volume(); }
-  double pressure() { return -(stress(0) + stress(1) + stress(2)) / 3; }
-  /// One step with velocity gradient l (D x D, row-major, 1/s) over dt.
-  void step(const std::vector<double>& l, double dt) {
-    double f[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    double tr = 0;
-    for (int i = 0; i < D; ++i) {
-      tr += l[size_t(i * D + i)];
-      for (int j = 0; j < D; ++j) f[i][j] += l[size_t(i * D + j)] * dt;
-    }
-    const double det = f[0][0] * (f[1][1] * f[2][2] - f[1][2] * f[2][1]) -
-                       f[0][1] * (f[1][0] * f[2][2] - f[1][2] * f[2][0]) +
-                       f[0][2] * (f[1][0] * f[2][1] - f[1][1] * f[2][0]);
-    volume() *= exact_volume ? std::exp(tr * dt) : det;
-    for (int k = 0; k < D * D; ++k) L[size_t(k) * loam::kBlock] = l[size_t(k)];
-    batch.dt = dt;
-    sim->materials[0]->update_stress(batch);
-  }
-  double wave_speed() {
-    return sim->materials[0]->wave_speed(sim->particles, 0, sim->particles.size());
-  }
-  double energy() { return sim->materials[0]->strain_energy(sim->particles, 0, 1); }
+struct Point : loam_test::MaterialPoint<D> {
+  explicit Point(const std::string& material)
+      : loam_test::MaterialPoint<D>(material, loam_test::VolumeUpdate::det, "water") {}
 };
 
 /// Compress (factor < 1) or stretch the volume of a point by `factor` in n equal steps of
@@ -88,9 +44,9 @@ double change_volume(Point<D>& pt, double factor, int n) {
   for (int i = 0; i < D; ++i) l[size_t(i * D + i)] = a;
   double work = 0;
   for (int i = 0; i < n; ++i) {
-    const double p0 = pt.pressure(), v0 = pt.volume();
+    const double p0 = pt.p(), v0 = pt.volume();
     pt.step(l, dt);
-    work -= 0.5 * (p0 + pt.pressure()) * (pt.volume() - v0);  // trapezoid rule
+    work -= 0.5 * (p0 + pt.p()) * (pt.volume() - v0);  // trapezoid rule
   }
   return work;
 }
@@ -109,12 +65,12 @@ TEST_CASE("newtonian_fluid: pressure from a prescribed compression matches K (rh
   double worst = 0;
   auto check = [&](auto& pt, int dim) {
     change_volume(pt, 0.99, 100);
-    const double err = std::fabs(pt.pressure() - hand) / hand;
+    const double err = std::fabs(pt.p() - hand) / hand;
     worst = std::max(worst, err);
     std::printf(
         "fluid %dD compression to 0.99 V0: p %.9f Pa, hand K(1/0.99 - 1) %.9f Pa, rel err "
         "%.2e; sigma_xx %.9f sigma_zz %.9f Pa\n",
-        dim, pt.pressure(), hand, err, pt.stress(0), pt.stress(2));
+        dim, pt.p(), hand, err, pt.stress(0), pt.stress(2));
     CHECK(err <= 1e-10);
   };
   Point<1> p1(fluid());
@@ -203,20 +159,20 @@ TEST_CASE("newtonian_fluid: the cavitation cutoff holds under tension", "[materi
     const double dt = 1e-3, a = (std::pow(1.01, 1.0 / 300) - 1) / dt;
     for (int i = 0; i < 100; ++i) {
       pt.step({a, 0, 0, 0, a, 0, 0, 0, a}, dt);
-      worst = std::min(worst, pt.pressure() - std::max(c.expect, kK * (pt.rho() / kRho0 - 1)));
+      worst = std::min(worst, pt.p() - std::max(c.expect, kK * (pt.rho() / kRho0 - 1)));
     }
-    const double p_stretched = pt.pressure();
+    const double p_stretched = pt.p();
     const double err = std::fabs(p_stretched - c.expect) / std::max(1.0, std::fabs(c.expect));
     const double back = 0.995 / (pt.volume() / (pt.mass() / kRho0));
     change_volume(pt, back, 50);
     const double again = kK * (1 / 0.995 - 1);
-    const double err_back = std::fabs(pt.pressure() - again) / again;
+    const double err_back = std::fabs(pt.p() - again) / again;
     std::printf(
         "fluid stretched to 1.01 V0 (%s): p %.9f Pa, expected %.9f Pa, rel err %.2e, largest "
         "undershoot below max(cutoff, EOS) %.2e Pa; recompressed to 0.995 V0: p %.6f Pa, EOS "
         "%.6f Pa (rel %.2e)\n",
         c.extra.empty() ? "no cutoff" : c.extra.c_str() + 2, p_stretched, c.expect, err, -worst,
-        pt.pressure(), again, err_back);
+        pt.p(), again, err_back);
     CHECK(err <= 1e-9);
     CHECK(worst >= -1e-9);
     CHECK(err_back <= 1e-9);
@@ -275,7 +231,7 @@ TEST_CASE("newtonian_fluid: a rigid rotation produces no stress", "[material][un
   const int steps = 1000;
   const double dt = 1e-3, w = M_PI / 2 / steps / dt;
   Point<2> exact(fluid(0.5)), scheme(fluid(0.5));
-  exact.exact_volume = true;
+  exact.volume_update = loam_test::VolumeUpdate::exp;
   double worst = 0;
   for (int i = 0; i < steps; ++i) {
     exact.step({0, -w, w, 0}, dt);
@@ -290,10 +246,10 @@ TEST_CASE("newtonian_fluid: a rigid rotation produces no stress", "[material][un
       "fluid rigid rotation 90 deg in %d steps (w dt %.3e): max |stress| %.2e Pa with the "
       "exact volume update; with det(I + L dt): V/V0 - 1 = %.3e, p %.3f Pa (= K(rho/rho0 - 1) "
       "%.3f Pa), deviator %.2e Pa\n",
-      steps, w * dt, worst, scheme.volume() / (scheme.mass() / kRho0) - 1, scheme.pressure(),
-      p_expected, dev);
+      steps, w * dt, worst, scheme.volume() / (scheme.mass() / kRho0) - 1, scheme.p(), p_expected,
+      dev);
   CHECK(worst == 0.0);
-  CHECK(std::fabs(scheme.pressure() - p_expected) <= 1e-9 * std::fabs(p_expected));
+  CHECK(std::fabs(scheme.p() - p_expected) <= 1e-9 * std::fabs(p_expected));
   CHECK(dev == 0.0);
 }
 
@@ -304,10 +260,10 @@ TEST_CASE("newtonian_fluid: stored energy equals the work of the pressure", "[ma
   for (const std::string extra : {"", ", cavitation_pressure: 10e3"}) {
     Point<3> pt(fluid(0, extra));
     const double w1 = change_volume(pt, 0.99, 2000);
-    const double e1 = pt.energy();
+    const double e1 = pt.strain_energy();
     Point<3> q(fluid(0, extra));
     const double w2 = change_volume(q, 1.005, 2000);
-    const double e2 = q.energy();
+    const double e2 = q.strain_energy();
     std::printf(
         "fluid energy (%s): compressed 1%%: energy %.9e J, work %.9e J (rel %.2e); stretched "
         "0.5%%: energy %.9e J, work %.9e J (rel %.2e)\n",
@@ -370,13 +326,7 @@ TEST_CASE("newtonian_fluid: a water column under gravity settles to hydrostatic 
 }
 
 TEST_CASE("newtonian_fluid: bad parameters give the located error", "[material][unit]") {
-  loam_test::TempDir dir("newtonian_fluid_bad");
-  std::filesystem::create_directories(dir.path);
-  const auto cfg = dir.path / "run.yaml";
-  struct Case {
-    std::string params, line;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<loam_test::BadMaterial> cases = {
       {"bulk_modulus: 2.0e9, viscosity: -1.0e-3",
        ":7:86: error: bodies.0.material.viscosity: -0.001 is out of range [0, inf) Pa s"},
       {"bulk_modulus: 0, viscosity: 1.0e-3",
@@ -384,16 +334,5 @@ TEST_CASE("newtonian_fluid: bad parameters give the located error", "[material][
       {"bulk_modulus: 2.0e9, viscosity: 1.0e-3, cavitation_pressure: -1",
        ":7:115: error: bodies.0.material.cavitation_pressure: -1 is out of range [0, inf) Pa"},
   };
-  for (const auto& k : cases) {
-    std::ofstream(cfg) << "grid:\n  extent: [4]\n  cell_size: 1\nbodies:\n  - name: water\n"
-                          "    generator: {type: box, min: [0], max: [2]}\n"
-                          "    material: {type: newtonian_fluid, density: 1000, "
-                       << k.params << "}\ntime:\n  end: 0.1\n";
-    auto r = loam_test::run_loam("run " + cfg.string() + " --quiet --out " +
-                                 (dir.path / "out").string());
-    std::printf("%s", r.output.c_str());
-    CHECK(r.exit_code == 2);
-    CHECK(r.output == cfg.string() + k.line + "\n");  // exactly this one line (column: value)
-    CHECK_FALSE(std::filesystem::exists(dir.path / "out"));
-  }
+  loam_test::check_bad_material("type: newtonian_fluid, density: 1000, ", cases, "water");
 }

@@ -6,16 +6,13 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <random>
 #include <vector>
 
 #include "cli.hpp"
 #include "framework/element_test.hpp"
 #include "framework/tensor.hpp"
-#include "sim_helpers.hpp"
-
-using loam_test::make_simulation;
+#include "material_point.hpp"
 
 namespace {
 
@@ -43,74 +40,23 @@ struct Soft {
   }
 };
 
-std::string config(int dim, const std::string& material) {
-  std::string ext = dim == 3 ? "[1, 1, 1]" : dim == 2 ? "[1, 1]" : "[1]";
-  std::string lo = dim == 3 ? "[0.25, 0.25, 0.25]" : dim == 2 ? "[0.25, 0.25]" : "[0.25]";
-  std::string hi = dim == 3 ? "[0.5, 0.5, 0.5]" : dim == 2 ? "[0.5, 0.5]" : "[0.5]";
-  return "grid: {extent: " + ext +
-         ", cell_size: 0.25}\nshape_function: linear\nbodies:\n"
-         "  - name: soil\n    generator: {type: box, min: " +
-         lo + ", max: " + hi + "}\n    material: " + material + "\ntime: {end: 1}\n";
-}
-
 double rad(double deg) {
   return deg * M_PI / 180;
-}
-
-/// Ordered principal stresses (tension positive) of a Voigt stress with NS components.
-Eigen::Vector3d principal(const double* v6) {
-  Eigen::Matrix3d m;
-  m << v6[0], v6[3], v6[5], v6[3], v6[1], v6[4], v6[5], v6[4], v6[2];
-  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(m).eigenvalues();  // ascending
 }
 
 /// One material point of the first particle of any material with a plastic_strain_eq field,
 /// strain-driven with L = strain increment (dt = 1).
 template <int D>
-struct Point {
-  static constexpr int NS = loam::Particles<D>::NS;
-  std::unique_ptr<loam::Simulation<D>> sim;
-  std::vector<double> L = std::vector<double>(size_t(D * D) * loam::kBlock, 0.0);
-  loam::MaterialBatch<D> batch;
-  int eq = -1;
+struct Point : loam_test::MaterialPoint<D> {
+  int eq = this->sim->particles.find("plastic_strain_eq");
 
-  explicit Point(const std::string& material) : sim(make_simulation<D>(config(D, material))) {
-    auto& P = sim->particles;
-    batch.begin = 0;
-    batch.count = 1;
-    batch.L = L.data();
-    batch.particles = &P;
-    batch.dt = 1.0;
-    eq = P.find("plastic_strain_eq");
+  explicit Point(const std::string& material) : loam_test::MaterialPoint<D>(material) {
     REQUIRE(eq >= 0);
   }
-  double& stress(int c_) { return sim->particles.col(sim->particles.stress, c_)[0]; }
-  double& eqps() { return sim->particles.col(eq)[0]; }
-  void isotropic(double s) {
-    for (int k = 0; k < NS; ++k) stress(k) = k < 3 ? s : 0.0;
-  }
-  void step(const std::vector<double>& de) {
-    for (int k = 0; k < D * D; ++k) L[size_t(k) * loam::kBlock] = de[size_t(k)];
-    sim->materials[0]->update_stress(batch);
-  }
-  std::vector<double> save() {
-    std::vector<double> s(NS + 1);
-    for (int k = 0; k < NS; ++k) s[size_t(k)] = stress(k);
-    s[NS] = eqps();
-    return s;
-  }
-  void restore(const std::vector<double>& s) {
-    for (int k = 0; k < NS; ++k) stress(k) = s[size_t(k)];
-    eqps() = s[NS];
-  }
-  Eigen::Vector3d principal_stress() {
-    double v[6] = {0, 0, 0, 0, 0, 0};
-    for (int k = 0; k < NS; ++k) v[k] = stress(k);
-    return principal(v);
-  }
+  double& eqps() { return this->field(eq); }
   /// Mohr-Coulomb yield value with cohesion c and friction angle phi, and a stress scale.
   std::pair<double, double> yield(double c, double phi) {
-    const Eigen::Vector3d ev = principal_stress();
+    const Eigen::Vector3d ev = this->principal_stress();
     const double s1 = ev[2], s3 = ev[0];
     const double sp = std::sin(rad(phi)), cp = std::cos(rad(phi));
     return {(s1 - s3) + (s1 + s3) * sp - 2 * c * cp, 2 * c * cp + ev.cwiseAbs().maxCoeff()};
@@ -133,22 +79,7 @@ std::vector<Row> drained_compression(Point<D>& pt, const Soft& m, double s3, dou
   pt.eqps() = 0;
   const double da = strain / n;
   for (int i = 0; i < n; ++i) {
-    const auto saved = pt.save();
-    auto run = [&](double e) {
-      pt.restore(saved);
-      std::vector<double> de(size_t(D * D), 0.0);
-      de[0] = -da;
-      for (int k = 1; k < D; ++k) de[size_t(k * D + k)] = e;
-      pt.step(de);
-      return pt.stress(1) + s3;
-    };
-    double e0 = kNu * da, e1 = 2 * kNu * da;
-    double r0 = run(e0), r1 = run(e1);
-    for (int it = 0; it < 60 && std::fabs(r1) > 1e-10 * s3; ++it) {
-      const double e2 = e1 - r1 * (e1 - e0) / (r1 - r0);
-      e0 = e1, r0 = r1, e1 = e2, r1 = run(e1);
-    }
-    REQUIRE(std::fabs(r1) <= 1e-9 * s3);
+    pt.compress_at_lateral_stress(da, s3, kNu);
     auto [f, scale] = pt.yield(m);
     rows.push_back({da * (i + 1), -pt.stress(0), pt.eqps(), f / scale});
   }
@@ -412,14 +343,8 @@ TEST_CASE("strain_softening_mc: a rigid rotation of a softening point keeps its 
 }
 
 TEST_CASE("strain_softening_mc: bad parameters give the located error", "[material][unit]") {
-  loam_test::TempDir dir("strain_softening_mc_bad");
-  std::filesystem::create_directories(dir.path);
-  const auto cfg = dir.path / "run.yaml";
-  struct Case {
-    std::string params, line;
-  };
   // Columns point at the offending value on line 7.
-  const std::vector<Case> cases = {
+  const std::vector<loam_test::BadMaterial> cases = {
       {"E: 1.0e6, nu: 0.3, c_peak: 1000, c_residual: 2000, phi_peak: 30, phi_residual: 20, "
        "psi_peak: 5, psi_residual: 0, softening_end: 0.1",
        ":7:103: error: bodies.0.material.c_residual: residual c_residual = 2000 must not exceed "
@@ -457,16 +382,5 @@ TEST_CASE("strain_softening_mc: bad parameters give the located error", "[materi
        "psi_peak: 5, psi_residual: 0, softening_end: 0.1",
        ":7:61: error: bodies.0.material.E: 0 is out of range (0, inf) Pa"},
   };
-  for (const auto& k : cases) {
-    std::ofstream(cfg) << "grid:\n  extent: [4]\n  cell_size: 1\nbodies:\n  - name: bar\n"
-                          "    generator: {type: box, min: [0], max: [2]}\n"
-                          "    material: {type: strain_softening_mc, density: 2000, "
-                       << k.params << "}\ntime:\n  end: 0.1\n";
-    auto r = loam_test::run_loam("run " + cfg.string() + " --quiet --out " +
-                                 (dir.path / "out").string());
-    std::printf("%s", r.output.c_str());
-    CHECK(r.exit_code == 2);
-    CHECK(r.output == cfg.string() + k.line + "\n");  // exactly this one line (column: value)
-    CHECK_FALSE(std::filesystem::exists(dir.path / "out"));
-  }
+  loam_test::check_bad_material("type: strain_softening_mc, density: 2000, ", cases);
 }
