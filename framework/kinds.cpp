@@ -4,6 +4,8 @@
 LOAM_REGISTER_KIND("shape_function", "interpolation between particles and grid nodes")
 LOAM_REGISTER_KIND("scheme", "what one explicit step does (mixture formulation, update order)")
 LOAM_REGISTER_KIND("material", "constitutive model; stress tension positive (Pa)")
+LOAM_REGISTER_KIND("drag",
+                   "interaction force between pore water and soil skeleton (two-phase schemes)")
 LOAM_REGISTER_KIND("boundary", "constraints on grid-face nodes")
 LOAM_REGISTER_KIND("load", "external forces on particles or nodes")
 LOAM_REGISTER_KIND("damping", "numerical damping of nodal forces")
