@@ -1,0 +1,334 @@
+// Saturated soil with one set of material points carrying both phases: the v-w formulation of
+// seed 001 (its eqs. 11-17; Jassim, Stolle & Vermeer 2013; Zabala & Alonso 2011).
+//
+// Per particle: solid velocity v (the `velocity` field), water velocity w, porosity n, excess
+// pore pressure p (COMPRESSION POSITIVE, Pa), effective stress sigma' (the material's `stress`,
+// tension positive). Total stress sigma = sigma' - p I. The particle `mass` is the solid mass
+// (1 - n0) rho_s V0 (the material's density is the grain density rho_s); the water mass
+// n rho_w V follows the current porosity and volume.
+//
+// Per step (update-stress-last, lumped masses, explicit in the forces):
+//   1. particle -> grid: solid mass and momentum, water mass and momentum, and per node
+//        mixture force  F   = sum [ -V (sigma' - p I) grad N + (m_s + m_w) g N + f_ext N ]
+//        water force    F_w = sum [  V n p grad N + m_w g N ]          (-n grad p, weak form)
+//        drag           Q_I = sum V Q_p N     (Q from the drag plugin, per unit mixture volume:
+//                                              force on the water -Q (w - v))
+//   2. grid: water momentum m_w dw/dt = F_w - Q (w - v) and mixture momentum
+//      m_s dv/dt + m_w dw/dt = F, with the drag IMPLICIT node by node: per node and component
+//        (m_w/dt + Q) w' - Q v'           = m_w w/dt + F_w
+//        -Q w'          + (m_s/dt + Q) v' = m_s v/dt + F - F_w
+//      (a 2x2 solve, unconditionally stable in Q, so low permeability does not shrink the time
+//      step). Boundary conditions act on both phases (a fixed or slip face is impermeable: the
+//      water cannot cross it either); a face without a condition is free and drained (p = 0
+//      is the natural condition of the water equation).
+//   3. grid -> particle: FLIP/PIC update of v and w from the grid accelerations, positions move
+//      with the solid grid velocity.
+//   4. particle update from the updated grid velocities: L_s = grad v, L_w = grad w;
+//      V <- det(I + L_s dt) V; solid volume (1 - n) V is conserved, so n <- 1 - (1 - n)/J;
+//      p <- p - dt K_w/n [ (1 - n) tr L_s + n tr L_w ]        (storage equation, eq. 15)
+//      and the material updates sigma' with L_s (Jaumann rate), one call per block.
+// Time step: the CFL limit with the undrained P-wave speed sqrt((M + K_w/n)/rho_sat) and the
+// water wave speed sqrt(K_w/rho_w); no drag limit (implicit drag).
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "framework/drag.hpp"
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+
+namespace loam {
+
+template <int D>
+class TwoPhaseSinglePoint : public Scheme<D> {
+ public:
+  static constexpr const char* name = "two_phase_single_point";
+  static constexpr const char* summary =
+      "saturated soil, one point per volume carrying solid and water (v-w formulation, "
+      "seed 001), implicit nodal drag";
+  static Schema schema() {
+    Schema s;
+    s.plugin("drag", "drag", "drag law between water and skeleton (darcy, ergun)").required();
+    s.real("porosity", "-", "initial porosity n0 of every body (0 < n0 < 1)")
+        .required()
+        .above(0)
+        .below(1);
+    s.real("water_bulk_modulus", "Pa", "bulk modulus K_w of the pore water (2.2e9 for water)")
+        .def("2.2e9")
+        .positive();
+    s.real("flip", "-", "FLIP fraction of the particle velocity update (1: FLIP, 0: PIC)")
+        .def("1")
+        .min(0)
+        .max(1);
+    return s;
+  }
+  explicit TwoPhaseSinglePoint(const Params& p)
+      : drag_(Registry::instance().create<Drag, D>(p.section("drag"))),
+        n0_(p.real("porosity")),
+        Kw_(p.real("water_bulk_modulus")),
+        flip_(p.real("flip")) {}
+
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    auto& P = sim.particles;
+    w_ = P.request({"water_velocity", D, "m/s", "pore water velocity", Particles<D>::axis_names()});
+    n_ = P.request({"porosity", 1, "-", "porosity (pore volume / total volume)", {}});
+    p_ = P.request(
+        {"pore_pressure", 1, "Pa", "excess pore water pressure, compression positive", {}});
+    rho_w_ = drag_->water_density();
+    for (size_t i = 0; i < P.size(); ++i) {
+      P.col(n_)[i] = n0_;
+      P.col(P.mass)[i] *= 1 - n0_;  // solid mass: the material density is rho_s
+      for (int d = 0; d < D; ++d) P.col(w_, d)[i] = P.col(P.velocity, d)[i];
+    }
+    drag_->setup(sim, diag);
+    node_.assign(sim.grid.num_nodes * S, 0.0);
+    scratch_.resize(size_t(sim.threads));
+    const int npp = sim.shape->nodes_per_particle();
+#pragma omp parallel num_threads(sim.threads)
+    {
+      auto s = std::make_unique<Scratch>();
+      s->stencil.allocate(npp);
+      s->L.assign(size_t(D * D * kBlock), 0.0);
+      s->Q.assign(size_t(kBlock), 0.0);
+      scratch_[size_t(omp_get_thread_num())] = std::move(s);
+    }
+  }
+
+  double stable_dt(const Simulation<D>& sim) const override {
+    // Undrained P-wave: M + K_w/n over the saturated density; M from the materials' drained
+    // speed c_d on the dry density m_s/V (c_d^2 = M / rho_dry).
+    const auto& P = sim.particles;
+    double c2 = Kw_ / rho_w_;  // water wave
+    for (size_t m = 0; m < sim.materials.size(); ++m) {
+      const auto& r = sim.partition.material_ranges[m];
+      if (r.end <= r.begin) continue;
+      const double cd = sim.materials[m]->wave_speed(P, r.begin, r.end);
+      for (size_t i = r.begin; i < r.end; ++i) {
+        const double V = P.col(P.volume)[i], n = P.col(n_)[i];
+        const double rho_dry = P.col(P.mass)[i] / V, rho_sat = rho_dry + n * rho_w_;
+        c2 = std::max(c2, (cd * cd * rho_dry + Kw_ / n) / rho_sat);
+      }
+    }
+    return sim.cfl * sim.grid.min_cell() / (std::sqrt(c2) + sim.max_speed);
+  }
+
+  std::vector<GridFieldView> grid_fields() const override {
+    return {{"mass", 1, node_.data(), S, 0},
+            {"velocity", D, node_.data(), S, kV},
+            {"water_velocity", D, node_.data(), S, kW}};
+  }
+
+  void step(Simulation<D>& sim, double dt) override {
+    with_stencil_size<D>(sim.shape->nodes_per_particle(), [&](auto npp) {
+      constexpr int NPP = decltype(npp)::value;
+      sim.timed("grid", [&] { std::fill(node_.begin(), node_.end(), 0.0); });
+      sim.timed("p2g", [&] {
+        sim.scatter_blocks([&](size_t b, int c, int t) { scatter<NPP>(sim, b, c, t); });
+      });
+      sim.timed("grid", [&] { integrate(sim, dt); });
+      for (auto& s : scratch_) s->max_v2 = 0;
+      sim.timed("g2p_gradient_stress", [&] {
+        sim.gather_blocks([&](size_t b, int c, int t) { update<NPP>(sim, dt, b, c, t); });
+      });
+      double m = 0;
+      for (auto& s : scratch_) m = std::max(m, s->max_v2);
+      sim.max_speed = std::sqrt(m);
+      for (auto& s : scratch_)
+        if (s->bad_porosity >= 0) {
+          const size_t i = size_t(s->bad_porosity);
+          sim.failure = "particle " + std::to_string(sim.particles.id[i]) +
+                        ": porosity left (0, 1) (n = " + format_number(sim.particles.col(n_)[i]) +
+                        "); the skeleton was compressed to zero pore volume or torn apart";
+          s->bad_porosity = -1;
+        }
+    });
+  }
+
+ private:
+  // Node record: solid mass, water mass, solid momentum -> velocity, water momentum ->
+  // velocity, mixture force -> solid acceleration, water force -> water acceleration, drag Q.
+  static constexpr int kMs = 0, kMw = 1, kV = 2, kW = 2 + D, kF = 2 + 2 * D, kFw = 2 + 3 * D,
+                       kQ = 2 + 4 * D, S = 3 + 4 * D;
+  static constexpr int NS = Particles<D>::NS;
+  std::unique_ptr<Drag<D>> drag_;
+  double n0_, Kw_, flip_, rho_w_ = 1000;
+  int w_ = -1, n_ = -1, p_ = -1;
+  std::vector<double> node_;
+  struct alignas(64) Scratch {
+    StencilBlock<D> stencil;
+    std::vector<double> L, Q;
+    double max_v2 = 0;
+    long bad_porosity = -1;  // a particle whose porosity left (0, 1) this step
+  };
+  std::vector<std::unique_ptr<Scratch>> scratch_;
+
+  template <int NPP>
+  void scatter(Simulation<D>& sim, size_t b, int count, int thread) {
+    Particles<D>& P = sim.particles;
+    Scratch& sc = *scratch_[size_t(thread)];
+    StencilBlock<D>& st = sc.stencil;
+    sim.shape->evaluate(sim.grid, P, b, count, st);
+    const int npp = NPP ? NPP : st.npp;
+    const double* ms = P.col(P.mass) + b;
+    const double* V = P.col(P.volume) + b;
+    const double* n = P.col(n_) + b;
+    const double* pw = P.col(p_) + b;
+    // Drag coefficients of the block (relative speeds only for speed-dependent laws).
+    double speed[kBlock];
+    if (drag_->speed_dependent())
+      for (int p = 0; p < count; ++p) {
+        double s2 = 0;
+        for (int d = 0; d < D; ++d) {
+          const double r = P.col(w_, d)[b + size_t(p)] - P.col(P.velocity, d)[b + size_t(p)];
+          s2 += r * r;
+        }
+        speed[p] = std::sqrt(s2);
+      }
+    drag_->coefficient(size_t(count), n, drag_->speed_dependent() ? speed : nullptr, sc.Q.data());
+    double* g = node_.data();
+    for (int p = 0; p < count; ++p) {
+      const size_t i = b + size_t(p);
+      const double mw = n[p] * rho_w_ * V[p];
+      double vs[D], vw[D], body[D], body_w[D], sv[D][D];
+      for (int d = 0; d < D; ++d) {
+        vs[d] = P.col(P.velocity, d)[i];
+        vw[d] = P.col(w_, d)[i];
+        const double fe = sim.external_force >= 0 ? P.col(sim.external_force, d)[i] : 0.0;
+        body[d] = (ms[p] + mw) * sim.gravity[size_t(d)] + fe;
+        body_w[d] = mw * sim.gravity[size_t(d)];
+        for (int j = 0; j < D; ++j)
+          sv[d][j] = V[p] * (P.col(P.stress, voigt_index(d, j))[i] - (d == j ? pw[p] : 0.0));
+      }
+      const double vnp = V[p] * n[p] * pw[p], vq = V[p] * sc.Q[size_t(p)];
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        const double w = st.w[kp];
+        double* r = g + size_t(st.node[kp]) * S;
+        r[kMs] += w * ms[p];
+        r[kMw] += w * mw;
+        r[kQ] += w * vq;
+        double gr[D];
+        for (int j = 0; j < D; ++j)
+          gr[j] = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
+        for (int d = 0; d < D; ++d) {
+          r[kV + d] += w * ms[p] * vs[d];
+          r[kW + d] += w * mw * vw[d];
+          double f = w * body[d];
+          for (int j = 0; j < D; ++j) f -= sv[d][j] * gr[j];
+          r[kF + d] += f;
+          r[kFw + d] += w * body_w[d] + vnp * gr[d];
+        }
+      }
+    }
+  }
+
+  /// Nodal velocities and accelerations of both phases, drag implicit (see the header).
+  void integrate(Simulation<D>& sim, double dt) {
+    sim.apply_grid_loads(NodalVector{node_.data(), S, kF});
+    const long nn = long(sim.grid.num_nodes);
+    const double tol = sim.mass_tolerance;
+    double* g = node_.data();
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+    for (long i = 0; i < nn; ++i) {
+      double* r = g + size_t(i) * S;
+      const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
+      if (ms <= tol) {
+        for (int c = kV; c < S; ++c) r[c] = 0.0;
+        continue;
+      }
+      for (int d = 0; d < D; ++d) {
+        const double v = r[kV + d] / ms, w = mw > tol ? r[kW + d] / mw : v;
+        const double F = r[kF + d], Fw = r[kFw + d];
+        // [ mw/dt + Q    -Q        ] [w']   [ mw w/dt + Fw     ]
+        // [ -Q           ms/dt + Q ] [v'] = [ ms v/dt + F - Fw ]
+        const double a11 = mw / dt + Q, a22 = ms / dt + Q;
+        const double b1 = mw * w / dt + Fw, b2 = ms * v / dt + F - Fw;
+        const double det = a11 * a22 - Q * Q;
+        double wn = (b1 * a22 + Q * b2) / det, vn = (a11 * b2 + Q * b1) / det;
+        if (mw <= tol) wn = vn;
+        r[kV + d] = vn;
+        r[kW + d] = wn;
+        r[kF + d] = (vn - v) / dt;
+        r[kFw + d] = (wn - w) / dt;
+      }
+    }
+    sim.constrain_update(NodalVector{g, S, kV}, NodalVector{g, S, kF}, dt);
+    sim.constrain_update(NodalVector{g, S, kW}, NodalVector{g, S, kFw}, dt);
+  }
+
+  /// Grid to particles: velocities (FLIP/PIC), positions, gradients, volume, porosity, pore
+  /// pressure, and the material's effective-stress update for one block.
+  template <int NPP>
+  void update(Simulation<D>& sim, double dt, size_t b, int count, int thread) {
+    Particles<D>& P = sim.particles;
+    Scratch& sc = *scratch_[size_t(thread)];
+    StencilBlock<D>& st = sc.stencil;
+    sim.shape->evaluate(sim.grid, P, b, count, st);
+    const int npp = NPP ? NPP : st.npp;
+    const double* g = node_.data();
+    double* L = sc.L.data();
+    double max_v2 = sc.max_v2;
+    for (int p = 0; p < count; ++p) {
+      const size_t i = b + size_t(p);
+      double ls[D][D] = {}, lw[D][D] = {}, vn[D] = {}, wn[D] = {}, as[D] = {}, aw[D] = {};
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        const double w = st.w[kp];
+        const double* r = g + size_t(st.node[kp]) * S;
+        for (int d = 0; d < D; ++d) {
+          vn[d] += w * r[kV + d];
+          wn[d] += w * r[kW + d];
+          as[d] += w * r[kF + d];
+          aw[d] += w * r[kFw + d];
+        }
+        for (int j = 0; j < D; ++j) {
+          const double gj = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
+          for (int d = 0; d < D; ++d) {
+            ls[d][j] += r[kV + d] * gj;
+            lw[d][j] += r[kW + d] * gj;
+          }
+        }
+      }
+      double v2 = 0, trs = 0, trw = 0;
+      for (int d = 0; d < D; ++d) {
+        double& v = P.col(P.velocity, d)[i];
+        double& w = P.col(w_, d)[i];
+        v = flip_ * (v + dt * as[d]) + (1 - flip_) * vn[d];
+        w = flip_ * (w + dt * aw[d]) + (1 - flip_) * wn[d];
+        P.col(P.position, d)[i] += dt * vn[d];
+        v2 += v * v;
+        trs += ls[d][d];
+        trw += lw[d][d];
+        for (int j = 0; j < D; ++j) L[size_t(d * D + j) * kBlock + size_t(p)] = ls[d][j];
+      }
+      max_v2 = std::max(max_v2, v2);
+      // Volume, porosity (solid volume (1 - n) V conserved) and the storage equation.
+      double f[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+      for (int d = 0; d < D; ++d)
+        for (int j = 0; j < D; ++j) f[d][j] += ls[d][j] * dt;
+      const double J = f[0][0] * (f[1][1] * f[2][2] - f[1][2] * f[2][1]) -
+                       f[0][1] * (f[1][0] * f[2][2] - f[1][2] * f[2][0]) +
+                       f[0][2] * (f[1][0] * f[2][1] - f[1][1] * f[2][0]);
+      P.col(P.volume)[i] *= J;
+      double& n = P.col(n_)[i];
+      const double n_old = n;
+      n = 1 - (1 - n) / J;
+      P.col(p_)[i] -= dt * Kw_ / n_old * ((1 - n_old) * trs + n_old * trw);
+      if (!(n > 0 && n < 1)) sc.bad_porosity = long(i);
+    }
+    sc.max_v2 = max_v2;
+    MaterialBatch<D> batch;
+    batch.begin = b;
+    batch.count = count;
+    batch.dt = dt;
+    batch.L = L;
+    batch.particles = &P;
+    sim.materials[P.material[b]]->update_stress(batch);
+  }
+};
+
+LOAM_REGISTER(Scheme, TwoPhaseSinglePoint)
+
+}  // namespace loam
