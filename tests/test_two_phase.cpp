@@ -7,23 +7,49 @@
 
 #include "cli.hpp"
 
-TEST_CASE("two-phase: seed 001 Terzaghi column within 0.02 of the series at T = 0.05 to 1",
-          "[verification][two_phase]") {
+namespace {
+
+void check_terzaghi(const std::string& config) {
   // Reference: VERIFICATION.md C, p(z,t)/p0 series with c_v = k M / gamma_w = 1.0194 m^2/s,
   // one-way drainage, H = 1 m. Target (issue 6): max |p/p0 - exact| <= 0.02 at each T, the
   // degree of consolidation within 0.01.
   loam_test::TempDir dir("terzaghi");
-  auto s = loam_test::run_scene("seed001_terzaghi.yaml", dir.path,
-                                "--threads 1 --set output.every_time=10");
+  auto s = loam_test::run_scene(config, dir.path, "--threads 1 --set output.every_time=10");
   auto v = s["verify"];
   for (const char* T : {"0.05", "0.1", "0.2", "0.5", "1"}) {
-    const double e = v[std::string("max_error_T") + T],
-                 u = v[std::string("consolidation_degree_error_T") + T];
-    std::printf("Terzaghi T = %-4s: max |p/p0 - exact| = %.4f, |U - U_exact| = %.2e\n", T, e,
-                std::fabs(u));
+    const double e = v[std::string("max_error_T") + T];
+    const double u = v[std::string("consolidation_degree_error_T") + T];
+    std::printf("%s, T = %-4s: max |p/p0 - exact| = %.4f, |U - U_exact| = %.2e\n", config.c_str(),
+                T, e, std::fabs(u));
     CHECK(e <= 0.02);
     CHECK(std::fabs(u) <= 0.01);
   }
-  std::printf("Terzaghi: %ld steps, %.1f s wall\n", s["steps"].get<long>(),
+  std::printf("%s: %ld steps, %.1f s wall\n", config.c_str(), s["steps"].get<long>(),
               s["wall_seconds"].get<double>());
+}
+
+}  // namespace
+
+TEST_CASE("two-phase: seed 001 Terzaghi column within 0.02 of the series at T = 0.05 to 1",
+          "[verification][two_phase]") {
+  check_terzaghi("seed001_terzaghi.yaml");
+}
+
+TEST_CASE("two-phase: the 2D Terzaghi column gives the 1D answer", "[verification][two_phase]") {
+  check_terzaghi("seed001_terzaghi_2d.yaml");
+}
+
+TEST_CASE("two-phase: porosity outside (0, 1) and a negative conductivity are located errors",
+          "[two_phase][cli]") {
+  loam_test::TempDir dir("two_phase_bad");
+  const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/seed001_terzaghi.yaml";
+  auto r = loam_test::run_loam("run " + cfg + " --quiet --out " + dir.path.string() +
+                               " --set scheme.porosity=1.2" +
+                               " --set scheme.drag.hydraulic_conductivity=-1e-3");
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("error: scheme.porosity: 1.2 is out of range (0, 1)") != std::string::npos);
+  CHECK(r.output.find("error: scheme.drag.hydraulic_conductivity: -0.001 is out of range") !=
+        std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir.path));
 }
