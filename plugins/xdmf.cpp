@@ -48,7 +48,11 @@ class Xdmf : public Writer<D> {
     fr.attributes.push_back({"id", 1, "Int"});
     for (int h : fields_) {
       const FieldInfo& info = P.info(h);
-      int width = info.components == D && D < 3 ? 3 : info.components;  // pad vectors to 3
+      // Spatial vectors (components x, y, z) are padded to 3 for ParaView; in 1D a scalar field
+      // also has D components, so the component names decide.
+      const bool spatial =
+          !info.component_names.empty() && info.component_names[0] == "x" && info.components == D;
+      const int width = spatial ? 3 : info.components;
       write_columns(f, info.name, P, h, width);
       fr.attributes.push_back({info.name, width, "Float"});
     }
@@ -109,7 +113,7 @@ class Xdmf : public Writer<D> {
     write_dataset(f, "grid_position", xyz.data(), g.num_nodes, 3, H5T_NATIVE_DOUBLE);
     fr.grid_nodes = g.num_nodes;
     for (const auto& v : sim.scheme->grid_fields()) {
-      int width = v.components == D && D < 3 ? 3 : v.components;
+      const int width = v.components == D && D > 1 ? 3 : v.components;  // pad 2D vectors
       std::vector<double> buf(g.num_nodes * size_t(width), 0.0);
       for (size_t n = 0; n < g.num_nodes; ++n)
         for (int c = 0; c < v.components; ++c)
