@@ -18,10 +18,16 @@ std::string bench_scene(const std::string& scene, const std::string& shape,
                         const std::string& update) {
   // 2D: 160 x 160 cells of block, 2 x 2 particles per cell = 102 400 particles.
   // 3D: 24 x 24 x 22 cells of block, 2 x 2 x 2 particles per cell = 101 376 particles.
-  std::string common = "shape_function: " + shape +
-                       "\nscheme: {type: single_phase, update: " + update +
-                       "}\ntime: {end: 1.0e3, cfl: 0.5}\n";
-  if (scene == "elastic_block_2d")
+  // Two-phase variants: the same block, saturated (n = 0.4, k = 1e-4 m/s, K_w = 2.2 GPa).
+  const bool two_phase = scene.rfind("two_phase_", 0) == 0;
+  const std::string base = two_phase ? scene.substr(10) : scene;
+  const std::string scheme =
+      two_phase ? "{type: two_phase_single_point, porosity: 0.4, water_bulk_modulus: 2.2e9, "
+                  "drag: {type: darcy, hydraulic_conductivity: 1.0e-4}}"
+                : "{type: single_phase, update: " + update + "}";
+  std::string common =
+      "shape_function: " + shape + "\nscheme: " + scheme + "\ntime: {end: 1.0e3, cfl: 0.5}\n";
+  if (base == "elastic_block_2d")
     return common + R"(grid: {origin: [0, 0], extent: [1.0, 1.1], cell_size: 0.00625}
 gravity: [0, -9.81]
 bodies:
@@ -34,7 +40,7 @@ boundaries:
   - {type: slip, face: x-}
   - {type: slip, face: x+}
 )";
-  if (scene == "elastic_block_3d")
+  if (base == "elastic_block_3d")
     return common +
            R"(grid: {origin: [0, 0, 0], extent: [1.0, 1.0, 1.0], cell_size: 0.0416666666666667}
 gravity: [0, 0, -9.81]
@@ -72,7 +78,8 @@ int run_scene(const BenchOptions& opt, const std::string& scene, const std::stri
     std::string yaml = bench_scene(scene, shape, opt.update);
     if (yaml.empty()) {
       std::fprintf(stderr,
-                   "loam: error: unknown bench scene '%s' (elastic_block_2d, elastic_block_3d)\n",
+                   "loam: error: unknown bench scene '%s' (elastic_block_2d, elastic_block_3d, "
+                   "two_phase_elastic_block_2d, two_phase_elastic_block_3d)\n",
                    scene.c_str());
       return 2;
     }

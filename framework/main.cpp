@@ -76,7 +76,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1000000));
   bench->add_option("--threads", bench_opt.threads, "thread counts to run (default 1 2)");
   bench->add_option("--scenes", bench_opt.scenes,
-                    "scenes (default: elastic_block_2d elastic_block_3d)");
+                    "scenes (default: elastic_block_2d elastic_block_3d; two_phase_ prefix: "
+                    "the same block saturated, two_phase_single_point scheme)");
   bench->add_option("--update", bench_opt.update, "musl, usl or usf");
   bench->add_option("--shape-functions", bench_opt.shapes,
                     "shape functions (default linear; all: every one)");
