@@ -24,9 +24,10 @@
 //   3. grid -> particle: FLIP/PIC update of v and w from the grid accelerations, positions move
 //      with the solid grid velocity.
 //   4. particle update from the updated grid velocities: L_s = grad v, L_w = grad w;
-//      V <- det(I + L_s dt) V; solid volume (1 - n) V is conserved, so n <- 1 - (1 - n)/J;
-//      p <- p - dt K_w/n [ (1 - n) tr L_s + n tr L_w ]        (storage equation, eq. 15)
-//      and the material updates sigma' with L_s (Jaumann rate), one call per block.
+//      V <- det(I + L_s dt) V, F <- (I + L_s dt) F when requested; solid volume (1 - n) V is
+//      conserved, so n <- 1 - (1 - n)/J; p <- p - dt K_w/n [ (1 - n) tr L_s + n tr L_w ] (storage
+//      equation, eq. 15) and the material updates sigma' with L_s (Jaumann rate), one call per
+//      block.
 // Time step: the CFL limit with the undrained P-wave speed sqrt((M + K_w/n)/rho_sat) and the
 // water wave speed sqrt(K_w/rho_w); no drag limit (implicit drag).
 #include <omp.h>
@@ -121,6 +122,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   }
 
   void step(Simulation<D>& sim, double dt) override {
+    F_ = sim.particles.find("deformation_gradient");  // may be requested after our set-up
     with_stencil_size<D>(sim.shape->nodes_per_particle(), [&](auto npp) {
       constexpr int NPP = decltype(npp)::value;
       sim.timed("grid", [&] { std::fill(node_.begin(), node_.end(), 0.0); });
@@ -154,7 +156,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   static constexpr int NS = Particles<D>::NS;
   std::unique_ptr<Drag<D>> drag_;
   double n0_, Kw_, flip_, rho_w_ = 1000;
-  int w_ = -1, n_ = -1, p_ = -1;
+  int w_ = -1, n_ = -1, p_ = -1, F_ = -1;
   std::vector<double> node_;
   struct alignas(64) Scratch {
     StencilBlock<D> stencil;
@@ -312,6 +314,17 @@ class TwoPhaseSinglePoint : public Scheme<D> {
                        f[0][1] * (f[1][0] * f[2][2] - f[1][2] * f[2][0]) +
                        f[0][2] * (f[1][0] * f[2][1] - f[1][1] * f[2][0]);
       P.col(P.volume)[i] *= J;
+      if (F_ >= 0) {  // F^{n+1} = (I + L dt) F^n, for materials that requested it (hencky)
+        double fo[D][D];
+        for (int r = 0; r < D; ++r)
+          for (int c = 0; c < D; ++c) fo[r][c] = P.col(F_, r * D + c)[i];
+        for (int r = 0; r < D; ++r)
+          for (int c = 0; c < D; ++c) {
+            double sum = 0;
+            for (int k = 0; k < D; ++k) sum += f[r][k] * fo[k][c];
+            P.col(F_, r * D + c)[i] = sum;
+          }
+      }
       double& n = P.col(n_)[i];
       const double n_old = n;
       n = 1 - (1 - n) / J;
