@@ -37,6 +37,7 @@
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 #include "framework/tensor.hpp"
+#include "materials/isotropic_elasticity.hpp"
 
 namespace loam {
 
@@ -49,10 +50,7 @@ class LinearElastic : public Material<D> {
   static constexpr const char* summary =
       "isotropic linear elasticity: hypoelastic Jaumann rate or hyperelastic Hencky";
   static Schema schema() {
-    Schema s;
-    s.real("E", "Pa", "Young's modulus").required().positive();
-    s.real("nu", "-", "Poisson's ratio").required().above(-1).below(0.5);
-    s.real("density", "kg/m^3", "mass density").required().positive();
+    Schema s = isotropic_elastic_schema(false);
     s.choice("formulation", {"jaumann", "hencky"},
              "jaumann: hypoelastic Cauchy stress with the Jaumann rate (incremental, cheapest); "
              "hencky: hyperelastic from the deformation gradient F, sigma = tau / det F with the "

@@ -21,6 +21,7 @@
 #include "framework/diagnostics.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "materials/isotropic_elasticity.hpp"
 #include "materials/mohr_coulomb_return.hpp"
 
 namespace loam {
@@ -33,10 +34,7 @@ class MohrCoulomb : public Material<D> {
       "Mohr-Coulomb plasticity (c, phi, psi, tension cutoff), linear elastic, Jaumann rate; "
       "exact principal-stress return (plane, edges, apex)";
   static Schema schema() {
-    Schema s;
-    s.real("E", "Pa", "Young's modulus").required().positive();
-    s.real("nu", "-", "Poisson's ratio").required().min(0).below(0.5);
-    s.real("density", "kg/m^3", "mass density").required().positive();
+    Schema s = isotropic_elastic_schema(true);
     s.real("c", "Pa", "cohesion").required().non_negative();
     s.real("phi", "deg", "friction angle").required().min(0).below(90);
     s.real("psi", "deg", "dilation angle (non-associated flow; psi <= phi)")

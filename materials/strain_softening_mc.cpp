@@ -42,6 +42,7 @@
 #include "framework/diagnostics.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "materials/isotropic_elasticity.hpp"
 #include "materials/mohr_coulomb_return.hpp"
 
 namespace loam {
@@ -56,10 +57,7 @@ class StrainSofteningMC : public Material<D> {
       "Mohr-Coulomb whose c, phi, psi soften linearly from peak to residual with the equivalent "
       "plastic deviatoric strain; linear elastic, Jaumann rate; exact principal-stress return";
   static Schema schema() {
-    Schema s;
-    s.real("E", "Pa", "Young's modulus").required().positive();
-    s.real("nu", "-", "Poisson's ratio").required().min(0).below(0.5);
-    s.real("density", "kg/m^3", "mass density").required().positive();
+    Schema s = isotropic_elastic_schema(true);
     s.real("c_peak", "Pa", "peak cohesion").required().non_negative();
     s.real("c_residual", "Pa", "residual cohesion (<= c_peak)").required().non_negative();
     s.real("phi_peak", "deg", "peak friction angle").required().min(0).below(90);

@@ -10,6 +10,7 @@
 
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "framework/thread_scratch.hpp"
 
 namespace loam {
 
@@ -36,17 +37,11 @@ class SinglePhase : public Scheme<D> {
   void setup(Simulation<D>& sim, Diagnostics&) override {
     node_.assign(sim.grid.num_nodes * S, 0.0);
     vel_.assign(sim.grid.num_nodes * D, 0.0);
-    // Each thread allocates (and first touches) its own scratch, so buffers that are rewritten
-    // every block never share a cache line or page with another thread's.
-    scratch_.resize(size_t(sim.threads));
     const int npp = sim.shape->nodes_per_particle();
-#pragma omp parallel num_threads(sim.threads)
-    {
-      auto s = std::make_unique<Scratch>();
-      s->stencil.allocate(npp);
-      s->L.assign(size_t(D * D * kBlock), 0.0);
-      scratch_[size_t(omp_get_thread_num())] = std::move(s);
-    }
+    scratch_ = per_thread_scratch<Scratch>(sim.threads, [&](Scratch& s) {
+      s.stencil.allocate(npp);
+      s.L.assign(size_t(D * D * kBlock), 0.0);
+    });
   }
 
   std::vector<GridFieldView> grid_fields() const override {
@@ -84,12 +79,8 @@ class SinglePhase : public Scheme<D> {
   };
   std::vector<std::unique_ptr<Scratch>> scratch_;
 
-  NodalVector node_vector(int offset) {
-    return NodalVector{node_.data(), S, offset};
-  }
-  NodalVector vel_vector() {
-    return NodalVector{vel_.data(), D, 0};
-  }
+  NodalVector node_vector(int offset) { return NodalVector{node_.data(), S, offset}; }
+  NodalVector vel_vector() { return NodalVector{vel_.data(), D, 0}; }
 
   void zero(std::vector<double>& v, int threads) {
     const long n = long(v.size());

@@ -39,6 +39,7 @@
 #include "framework/drag.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "framework/thread_scratch.hpp"
 
 namespace loam {
 
@@ -85,16 +86,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     }
     drag_->setup(sim, diag);
     node_.assign(sim.grid.num_nodes * S, 0.0);
-    scratch_.resize(size_t(sim.threads));
     const int npp = sim.shape->nodes_per_particle();
-#pragma omp parallel num_threads(sim.threads)
-    {
-      auto s = std::make_unique<Scratch>();
-      s->stencil.allocate(npp);
-      s->L.assign(size_t(D * D * kBlock), 0.0);
-      s->Q.assign(size_t(kBlock), 0.0);
-      scratch_[size_t(omp_get_thread_num())] = std::move(s);
-    }
+    scratch_ = per_thread_scratch<Scratch>(sim.threads, [&](Scratch& s) {
+      s.stencil.allocate(npp);
+      s.L.assign(size_t(D * D * kBlock), 0.0);
+      s.Q.assign(size_t(kBlock), 0.0);
+    });
   }
 
   double stable_dt(const Simulation<D>& sim) const override {
