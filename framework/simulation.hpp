@@ -98,6 +98,17 @@ class Simulation {
   void constrain_update(const NodalVector& v, const NodalVector& a, double dt) const {
     for (const auto& b : boundaries) b->constrain_update(v, a, dt);
   }
+  /// The material stress update of one block [b, b + count) (one material per block), with
+  /// its velocity gradient L in block layout (MaterialBatch).
+  void update_block_stress(size_t b, int count, double dt, const double* L) {
+    MaterialBatch<D> batch;
+    batch.begin = b;
+    batch.count = count;
+    batch.dt = dt;
+    batch.L = L;
+    batch.particles = &particles;
+    materials[particles.material[b]]->update_stress(batch);
+  }
   void apply_grid_loads(const NodalVector& force) {
     for (const auto& l : loads) l->apply_to_grid(*this, force, time);
   }

@@ -1,5 +1,7 @@
 #pragma once
 // Small tensor helpers on Voigt-stored stress (xx yy zz xy yz xz) for D-dimensional kinematics.
+#include <array>
+
 #include "particles.hpp"
 
 namespace loam {
@@ -76,6 +78,40 @@ inline void voigt_to_matrix(const double (&v)[NS], double (&s)[3][3]) {
   s[0][1] = s[1][0] = NS > 3 ? v[3] : 0.0;
   s[1][2] = s[2][1] = NS > 4 ? v[4] : 0.0;
   s[0][2] = s[2][0] = NS > 5 ? v[5] : 0.0;
+}
+
+/// Volume ratio det(I + L dt) of one explicit step: V^{n+1} = det(I + L dt) V^n, the exact
+/// Jacobian of the particle motion x^{n+1} = x^n + v dt in a linear velocity field.
+template <int D>
+inline double det_increment(const double (&l)[D][D], double dt) {
+  if constexpr (D == 1) {
+    return 1.0 + l[0][0] * dt;
+  } else if constexpr (D == 2) {
+    return (1.0 + l[0][0] * dt) * (1.0 + l[1][1] * dt) - l[0][1] * l[1][0] * dt * dt;
+  } else {
+    double f[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) f[i][j] = (i == j ? 1.0 : 0.0) + l[i][j] * dt;
+    return f[0][0] * (f[1][1] * f[2][2] - f[1][2] * f[2][1]) -
+           f[0][1] * (f[1][0] * f[2][2] - f[1][2] * f[2][0]) +
+           f[0][2] * (f[1][0] * f[2][1] - f[1][1] * f[2][0]);
+  }
+}
+
+/// F^{n+1} = (I + L dt) F^n for particle p of a block; F holds the D*D component columns
+/// (F_ij at index i*D + j) at the block start.
+template <int D>
+inline void update_deformation_gradient(const std::array<double*, D * D>& F,
+                                        const double (&l)[D][D], double dt, int p) {
+  double f[D][D];
+  for (int i = 0; i < D; ++i)
+    for (int j = 0; j < D; ++j) f[i][j] = F[size_t(i * D + j)][p];
+  for (int i = 0; i < D; ++i)
+    for (int j = 0; j < D; ++j) {
+      double sum = f[i][j];
+      for (int k = 0; k < D; ++k) sum += l[i][k] * dt * f[k][j];
+      F[size_t(i * D + j)][p] = sum;
+    }
 }
 
 }  // namespace loam

@@ -10,6 +10,7 @@
 
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "framework/tensor.hpp"
 #include "framework/thread_scratch.hpp"
 
 namespace loam {
@@ -291,42 +292,7 @@ class SinglePhase : public Scheme<D> {
       }
     }
     sc.max_v2 = max_v2;
-    MaterialBatch<D> batch;
-    batch.begin = b;
-    batch.count = count;
-    batch.dt = dt;
-    batch.L = L;
-    batch.particles = &P;
-    sim.materials[P.material[b]]->update_stress(batch);
-  }
-
-  /// F^{n+1} = (I + L dt) F^n for particle p of the block.
-  static void update_deformation_gradient(const std::array<double*, D * D>& F,
-                                          const double (&l)[D][D], double dt, int p) {
-    double f[D][D];
-    for (int i = 0; i < D; ++i)
-      for (int j = 0; j < D; ++j) f[i][j] = F[size_t(i * D + j)][p];
-    for (int i = 0; i < D; ++i)
-      for (int j = 0; j < D; ++j) {
-        double sum = f[i][j];
-        for (int k = 0; k < D; ++k) sum += l[i][k] * dt * f[k][j];
-        F[size_t(i * D + j)][p] = sum;
-      }
-  }
-
-  static double det_increment(const double (&l)[D][D], double dt) {
-    if constexpr (D == 1) {
-      return 1.0 + l[0][0] * dt;
-    } else if constexpr (D == 2) {
-      return (1.0 + l[0][0] * dt) * (1.0 + l[1][1] * dt) - l[0][1] * l[1][0] * dt * dt;
-    } else {
-      double f[3][3];
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) f[i][j] = (i == j ? 1.0 : 0.0) + l[i][j] * dt;
-      return f[0][0] * (f[1][1] * f[2][2] - f[1][2] * f[2][1]) -
-             f[0][1] * (f[1][0] * f[2][2] - f[1][2] * f[2][0]) +
-             f[0][2] * (f[1][0] * f[2][1] - f[1][1] * f[2][0]);
-    }
+    sim.update_block_stress(b, count, dt, L);
   }
 
   void reset_max_speed() {

@@ -39,6 +39,7 @@
 #include "framework/drag.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "framework/tensor.hpp"
 #include "framework/thread_scratch.hpp"
 
 namespace loam {
@@ -269,6 +270,9 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     const double* g = node_.data();
     double* L = sc.L.data();
     double max_v2 = sc.max_v2;
+    std::array<double*, D * D> F{};  // deformation gradient, if a material requested it
+    if (F_ >= 0)
+      for (int c = 0; c < D * D; ++c) F[size_t(c)] = P.col(F_, c) + b;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       double ls[D][D] = {}, lw[D][D] = {}, vn[D] = {}, wn[D] = {}, as[D] = {}, aw[D] = {};
@@ -303,25 +307,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         for (int j = 0; j < D; ++j) L[size_t(d * D + j) * kBlock + size_t(p)] = ls[d][j];
       }
       max_v2 = std::max(max_v2, v2);
-      // Volume, porosity (solid volume (1 - n) V conserved) and the storage equation.
-      double f[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-      for (int d = 0; d < D; ++d)
-        for (int j = 0; j < D; ++j) f[d][j] += ls[d][j] * dt;
-      const double J = f[0][0] * (f[1][1] * f[2][2] - f[1][2] * f[2][1]) -
-                       f[0][1] * (f[1][0] * f[2][2] - f[1][2] * f[2][0]) +
-                       f[0][2] * (f[1][0] * f[2][1] - f[1][1] * f[2][0]);
+      // Volume, F, porosity (solid volume (1 - n) V conserved) and the storage equation.
+      const double J = det_increment<D>(ls, dt);
       P.col(P.volume)[i] *= J;
-      if (F_ >= 0) {  // F^{n+1} = (I + L dt) F^n, for materials that requested it (hencky)
-        double fo[D][D];
-        for (int r = 0; r < D; ++r)
-          for (int c = 0; c < D; ++c) fo[r][c] = P.col(F_, r * D + c)[i];
-        for (int r = 0; r < D; ++r)
-          for (int c = 0; c < D; ++c) {
-            double sum = 0;
-            for (int k = 0; k < D; ++k) sum += f[r][k] * fo[k][c];
-            P.col(F_, r * D + c)[i] = sum;
-          }
-      }
+      if (F[0]) update_deformation_gradient<D>(F, ls, dt, p);
       double& n = P.col(n_)[i];
       const double n_old = n;
       n = 1 - (1 - n) / J;
@@ -329,13 +318,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       if (!(n > 0 && n < 1)) sc.bad_porosity = long(i);
     }
     sc.max_v2 = max_v2;
-    MaterialBatch<D> batch;
-    batch.begin = b;
-    batch.count = count;
-    batch.dt = dt;
-    batch.L = L;
-    batch.particles = &P;
-    sim.materials[P.material[b]]->update_stress(batch);
+    sim.update_block_stress(b, count, dt, L);
   }
 };
 
