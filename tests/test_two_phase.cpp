@@ -11,18 +11,19 @@
 
 namespace {
 
-void check_terzaghi(const std::string& config) {
+void check_terzaghi(const std::string& config, const std::string& extra = "") {
   // Reference: VERIFICATION.md C, p(z,t)/p0 series with c_v = k M / gamma_w = 1.0194 m^2/s,
   // one-way drainage, H = 1 m. Target (issue 6): max |p/p0 - exact| <= 0.02 at each T, the
   // degree of consolidation within 0.01.
   loam_test::TempDir dir("terzaghi");
-  auto s = loam_test::run_scene(config, dir.path, "--threads 1 --set output.every_time=10");
+  auto s =
+      loam_test::run_scene(config, dir.path, "--threads 1 --set output.every_time=10 " + extra);
   auto v = s["verify"];
   for (const char* T : {"0.05", "0.1", "0.2", "0.5", "1"}) {
     const double e = v[std::string("max_error_T") + T];
     const double u = v[std::string("consolidation_degree_error_T") + T];
-    std::printf("%s, T = %-4s: max |p/p0 - exact| = %.4f, |U - U_exact| = %.2e\n", config.c_str(),
-                T, e, std::fabs(u));
+    std::printf("%s %s, T = %-4s: max |p/p0 - exact| = %.4f, |U - U_exact| = %.2e\n",
+                config.c_str(), extra.c_str(), T, e, std::fabs(u));
     CHECK(e <= 0.02);
     CHECK(std::fabs(u) <= 0.01);
   }
@@ -45,6 +46,17 @@ TEST_CASE("two-phase: seed 001 Terzaghi column within 0.02 of the series at T = 
 
 TEST_CASE("two-phase: the 2D Terzaghi column gives the 1D answer", "[verification][two_phase]") {
   check_terzaghi("seed001_terzaghi_2d.yaml");
+}
+
+TEST_CASE("two-phase: the Terzaghi column meets the target with every shape function",
+          "[verification][two_phase]") {
+  for (const char* sf : {"gimp", "bspline2", "cpdi"})
+    check_terzaghi("seed001_terzaghi.yaml", std::string("--set shape_function=") + sf);
+}
+
+TEST_CASE("two-phase: the 3D Terzaghi column gives the 1D answer",
+          "[verification][two_phase][full]") {
+  check_terzaghi("seed001_terzaghi_3d.yaml");
 }
 
 TEST_CASE("two-phase: porosity outside (0, 1) and a negative conductivity are located errors",
