@@ -7,7 +7,7 @@
 // (1 - n0) rho_s V0 (the material's density is the grain density rho_s); the water mass
 // n rho_w V follows the current porosity and volume.
 //
-// Per step (update-stress-last, lumped masses, explicit in the forces):
+// Per step (lumped masses, explicit in the forces; stress after the grid update):
 //   1. particle -> grid: solid mass and momentum, water mass and momentum, and per node
 //        mixture force  F   = sum [ -V (sigma' - p I) grad N + (m_s + m_w) g N + f_ext N ]
 //        water force    F_w = sum [  V n p grad N + m_w g N ]          (-n grad p, weak form)
@@ -22,8 +22,11 @@
 //      water cannot cross it either); a face without a condition is free and drained (p = 0
 //      is the natural condition of the water equation).
 //   3. grid -> particle: FLIP/PIC update of v and w from the grid accelerations, positions move
-//      with the solid grid velocity.
-//   4. particle update from the updated grid velocities: L_s = grad v, L_w = grad w;
+//      with the solid grid velocity. `update: musl` (default) then re-maps the new particle
+//      momenta of both phases to the grid (Sulsky 1995), and the gradients below use those
+//      velocities; `update: usl` uses the updated grid velocities directly (nearly empty nodes,
+//      e.g. at a moving drained surface, then give spurious gradients).
+//   4. particle update: L_s = grad v, L_w = grad w;
 //      V <- det(I + L_s dt) V, F <- (I + L_s dt) F when requested; solid volume (1 - n) V is
 //      conserved, so n <- 1 - (1 - n)/J; p <- p - dt K_w/n [ (1 - n) tr L_s + n tr L_w ] (storage
 //      equation, eq. 15) and the material updates sigma' with L_s (Jaumann rate), one call per
@@ -61,6 +64,11 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     s.real("water_bulk_modulus", "Pa", "bulk modulus K_w of the pore water (2.2e9 for water)")
         .def("2.2e9")
         .positive();
+    s.choice("update", {"musl", "usl"},
+             "musl: velocity gradients from the re-mapped particle momenta of both phases "
+             "(robust where nodes are nearly empty, e.g. a moving drained surface); usl: from "
+             "the updated grid velocities directly (one pass less)")
+        .def("musl");
     s.real("flip", "-", "FLIP fraction of the particle velocity update (1: FLIP, 0: PIC)")
         .def("1")
         .min(0)
@@ -71,7 +79,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       : drag_(Registry::instance().create<Drag, D>(p.section("drag"))),
         n0_(p.real("porosity")),
         Kw_(p.real("water_bulk_modulus")),
-        flip_(p.real("flip")) {}
+        flip_(p.real("flip")),
+        musl_(p.text("update") == "musl") {}
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     auto& P = sim.particles;
@@ -87,6 +96,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     }
     drag_->setup(sim, diag);
     node_.assign(sim.grid.num_nodes * S, 0.0);
+    if (musl_) remap_.assign(sim.grid.num_nodes * 2 * D, 0.0);
     const int npp = sim.shape->nodes_per_particle();
     scratch_ = per_thread_scratch<Scratch>(sim.threads, [&](Scratch& s) {
       s.stencil.allocate(npp);
@@ -129,9 +139,20 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       });
       sim.timed("grid", [&] { integrate(sim, dt); });
       for (auto& s : scratch_) s->max_v2 = 0;
-      sim.timed("g2p_gradient_stress", [&] {
-        sim.gather_blocks([&](size_t b, int c, int t) { update<NPP>(sim, dt, b, c, t); });
-      });
+      if (musl_) {
+        sim.timed("grid", [&] { std::fill(remap_.begin(), remap_.end(), 0.0); });
+        sim.timed("g2p_velocity_remap", [&] {
+          sim.scatter_blocks([&](size_t b, int c, int t) { remap<NPP>(sim, dt, b, c, t); });
+        });
+        sim.timed("grid", [&] { remapped_velocities(sim); });
+        sim.timed("g2p_gradient_stress", [&] {
+          sim.gather_blocks([&](size_t b, int c, int t) { update<NPP, true>(sim, dt, b, c, t); });
+        });
+      } else {
+        sim.timed("g2p_gradient_stress", [&] {
+          sim.gather_blocks([&](size_t b, int c, int t) { update<NPP, false>(sim, dt, b, c, t); });
+        });
+      }
       double m = 0;
       for (auto& s : scratch_) m = std::max(m, s->max_v2);
       sim.max_speed = std::sqrt(m);
@@ -154,6 +175,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   static constexpr int NS = Particles<D>::NS;
   std::unique_ptr<Drag<D>> drag_;
   double n0_, Kw_, flip_, rho_w_ = 1000;
+  bool musl_;
+  std::vector<double> remap_;  // MUSL: per node solid then water velocity (2 D values)
   int w_ = -1, n_ = -1, p_ = -1, F_ = -1;
   std::vector<double> node_;
   struct alignas(64) Scratch {
@@ -260,7 +283,79 @@ class TwoPhaseSinglePoint : public Scheme<D> {
 
   /// Grid to particles: velocities (FLIP/PIC), positions, gradients, volume, porosity, pore
   /// pressure, and the material's effective-stress update for one block.
+  /// MUSL first pass: FLIP/PIC update of both particle velocities, move, and scatter the new
+  /// particle momenta of both phases to the grid.
   template <int NPP>
+  void remap(Simulation<D>& sim, double dt, size_t b, int count, int thread) {
+    Particles<D>& P = sim.particles;
+    Scratch& sc = *scratch_[size_t(thread)];
+    StencilBlock<D>& st = sc.stencil;
+    sim.shape->evaluate(sim.grid, P, b, count, st);
+    const int npp = NPP ? NPP : st.npp;
+    const double* g = node_.data();
+    double max_v2 = sc.max_v2;
+    for (int p = 0; p < count; ++p) {
+      const size_t i = b + size_t(p);
+      double vn[D] = {}, wn[D] = {}, as[D] = {}, aw[D] = {};
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        const double w = st.w[kp];
+        const double* r = g + size_t(st.node[kp]) * S;
+        for (int d = 0; d < D; ++d) {
+          vn[d] += w * r[kV + d];
+          wn[d] += w * r[kW + d];
+          as[d] += w * r[kF + d];
+          aw[d] += w * r[kFw + d];
+        }
+      }
+      max_v2 = std::max(max_v2, flip_update(P, i, dt, vn, wn, as, aw));
+      const double ms = P.col(P.mass)[i], mw = P.col(n_)[i] * rho_w_ * P.col(P.volume)[i];
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        double* r = remap_.data() + size_t(st.node[kp]) * 2 * D;
+        for (int d = 0; d < D; ++d) {
+          r[d] += st.w[kp] * ms * P.col(P.velocity, d)[i];
+          r[D + d] += st.w[kp] * mw * P.col(w_, d)[i];
+        }
+      }
+    }
+    sc.max_v2 = max_v2;
+  }
+
+  /// Remapped momenta to velocities (node masses of the step), constrained like the update.
+  void remapped_velocities(Simulation<D>& sim) {
+    const long nn = long(sim.grid.num_nodes);
+    const double tol = sim.mass_tolerance;
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+    for (long i = 0; i < nn; ++i) {
+      const double ms = node_[size_t(i) * S + kMs], mw = node_[size_t(i) * S + kMw];
+      double* r = remap_.data() + size_t(i) * 2 * D;
+      for (int d = 0; d < D; ++d) {
+        r[d] = ms > tol ? r[d] / ms : 0.0;
+        r[D + d] = mw > tol ? r[D + d] / mw : r[d];
+      }
+    }
+    sim.constrain(NodalVector{remap_.data(), 2 * D, 0});
+    sim.constrain(NodalVector{remap_.data(), 2 * D, D});
+  }
+
+  /// FLIP/PIC update of v and w of particle i and its move with the solid grid velocity;
+  /// returns |v|^2.
+  double flip_update(Particles<D>& P, size_t i, double dt, const double (&vn)[D],
+                     const double (&wn)[D], const double (&as)[D], const double (&aw)[D]) {
+    double v2 = 0;
+    for (int d = 0; d < D; ++d) {
+      double& v = P.col(P.velocity, d)[i];
+      double& w = P.col(w_, d)[i];
+      v = flip_ * (v + dt * as[d]) + (1 - flip_) * vn[d];
+      w = flip_ * (w + dt * aw[d]) + (1 - flip_) * wn[d];
+      P.col(P.position, d)[i] += dt * vn[d];
+      v2 += v * v;
+    }
+    return v2;
+  }
+
+  template <int NPP, bool REMAPPED>
   void update(Simulation<D>& sim, double dt, size_t b, int count, int thread) {
     Particles<D>& P = sim.particles;
     Scratch& sc = *scratch_[size_t(thread)];
@@ -280,33 +375,31 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
         const double* r = g + size_t(st.node[kp]) * S;
-        for (int d = 0; d < D; ++d) {
-          vn[d] += w * r[kV + d];
-          wn[d] += w * r[kW + d];
-          as[d] += w * r[kF + d];
-          aw[d] += w * r[kFw + d];
-        }
+        // Velocities whose gradients are taken: re-mapped (MUSL) or updated grid ones (USL).
+        const double* vs = REMAPPED ? remap_.data() + size_t(st.node[kp]) * 2 * D : r + kV;
+        const double* vw = REMAPPED ? vs + D : r + kW;
+        if constexpr (!REMAPPED)
+          for (int d = 0; d < D; ++d) {
+            vn[d] += w * r[kV + d];
+            wn[d] += w * r[kW + d];
+            as[d] += w * r[kF + d];
+            aw[d] += w * r[kFw + d];
+          }
         for (int j = 0; j < D; ++j) {
           const double gj = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
           for (int d = 0; d < D; ++d) {
-            ls[d][j] += r[kV + d] * gj;
-            lw[d][j] += r[kW + d] * gj;
+            ls[d][j] += vs[d] * gj;
+            lw[d][j] += vw[d] * gj;
           }
         }
       }
-      double v2 = 0, trs = 0, trw = 0;
+      if constexpr (!REMAPPED) max_v2 = std::max(max_v2, flip_update(P, i, dt, vn, wn, as, aw));
+      double trs = 0, trw = 0;
       for (int d = 0; d < D; ++d) {
-        double& v = P.col(P.velocity, d)[i];
-        double& w = P.col(w_, d)[i];
-        v = flip_ * (v + dt * as[d]) + (1 - flip_) * vn[d];
-        w = flip_ * (w + dt * aw[d]) + (1 - flip_) * wn[d];
-        P.col(P.position, d)[i] += dt * vn[d];
-        v2 += v * v;
         trs += ls[d][d];
         trw += lw[d][d];
         for (int j = 0; j < D; ++j) L[size_t(d * D + j) * kBlock + size_t(p)] = ls[d][j];
       }
-      max_v2 = std::max(max_v2, v2);
       // Volume, F, porosity (solid volume (1 - n) V conserved) and the storage equation.
       const double J = det_increment<D>(ls, dt);
       P.col(P.volume)[i] *= J;
