@@ -315,6 +315,19 @@ bool Simulation<D>::particle_set(const std::string& name, std::vector<uint32_t>&
 }
 
 template <int D>
+int Simulation<D>::body_param(const Params& p, const std::string& key, Diagnostics& diag) const {
+  if (!p.has(key)) return 0;
+  const int b = body_index(p.text(key));
+  if (b < 0) {
+    std::vector<std::string> names;
+    for (const auto& bd : bodies) names.push_back(bd.name);
+    diag.error(p.where(key), p.path(key),
+               "unknown body '" + p.text(key) + "'; bodies are: " + join(names, ", "));
+  }
+  return b;
+}
+
+template <int D>
 int Simulation<D>::body_index(const std::string& name) const {
   for (size_t b = 0; b < bodies.size(); ++b)
     if (bodies[b].name == name) return int(b);

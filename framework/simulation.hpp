@@ -139,6 +139,9 @@ class Simulation {
   /// Ids of particles inside a named particle set; empty name = all. Returns false if unknown.
   bool particle_set(const std::string& name, std::vector<uint32_t>& ids) const;
   int body_index(const std::string& name) const;
+  /// The body a plugin names with `key` (the first body when the key is absent), or -1 after a
+  /// located "unknown body" error listing the bodies.
+  int body_param(const Params& p, const std::string& key, Diagnostics& diag) const;
 
   /// First particle whose position, velocity or stress is not finite, or that left the grid:
   /// returns false and fills a description.

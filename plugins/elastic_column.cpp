@@ -24,12 +24,8 @@ class ElasticColumn : public Reference<D> {
   explicit ElasticColumn(const Params& p) : params_(p) {}
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    body_ = params_.has("body") ? sim.body_index(params_.text("body")) : 0;
-    if (body_ < 0) {
-      diag.error(params_.where("body"), params_.path("body"),
-                 "unknown body '" + params_.text("body") + "'");
-      return;
-    }
+    body_ = sim.body_param(params_, "body", diag);
+    if (body_ < 0) return;
     const Body& b = sim.bodies[size_t(body_)];
     const Params& mat = b.params.section("material");
     if (!mat.has("E") || !mat.has("nu")) {

@@ -34,12 +34,8 @@ class GranularCollapse : public Reference<D> {
       diag.error(params_.where(), params_.path(), "granular_collapse needs a 2D or 3D grid");
       return;
     }
-    body_ = params_.has("body") ? sim.body_index(params_.text("body")) : 0;
-    if (body_ < 0) {
-      diag.error(params_.where("body"), params_.path("body"),
-                 "unknown body '" + params_.text("body") + "'");
-      return;
-    }
+    body_ = sim.body_param(params_, "body", diag);
+    if (body_ < 0) return;
     const Body& b = sim.bodies[size_t(body_)];
     x0_ = b.lower[0];
     L0_ = b.upper[0] - b.lower[0];

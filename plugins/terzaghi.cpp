@@ -68,12 +68,8 @@ class Terzaghi : public Reference<D> {
     if (pore_ < 0)
       diag.error(params_.where(), params_.path(),
                  "terzaghi needs a two-phase scheme (no pore_pressure field)");
-    body_ = params_.has("body") ? sim.body_index(params_.text("body")) : 0;
-    if (body_ < 0) {
-      diag.error(params_.where("body"), params_.path("body"),
-                 "unknown body '" + params_.text("body") + "'");
-      return;
-    }
+    body_ = sim.body_param(params_, "body", diag);
+    if (body_ < 0) return;
     const Body& b = sim.bodies[size_t(body_)];
     H0_ = b.upper[D - 1] - b.lower[D - 1];
     auto [zmin, zmax] = span(sim);

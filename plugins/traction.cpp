@@ -42,14 +42,8 @@ class Traction : public Load<D> {
         return;
       }
     } else {
-      int b = sim.body_index(params_.text("body"));
-      if (b < 0) {
-        std::vector<std::string> names;
-        for (const auto& bd : sim.bodies) names.push_back(bd.name);
-        diag.error(params_.where("body"), params_.path("body"),
-                   "unknown body '" + params_.text("body") + "'; bodies are: " + join(names, ", "));
-        return;
-      }
+      const int b = sim.body_param(params_, "body", diag);
+      if (b < 0) return;
       const Body& body = sim.bodies[size_t(b)];
       const double plane =
           face_.upper ? body.upper[size_t(face_.axis)] : body.lower[size_t(face_.axis)];

@@ -26,12 +26,8 @@ class VibratingBar : public Reference<D> {
   explicit VibratingBar(const Params& p) : params_(p), v0_(p.real("v0")) {}
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    body_ = params_.has("body") ? sim.body_index(params_.text("body")) : 0;
-    if (body_ < 0) {
-      diag.error(params_.where("body"), params_.path("body"),
-                 "unknown body '" + params_.text("body") + "'");
-      return;
-    }
+    body_ = sim.body_param(params_, "body", diag);
+    if (body_ < 0) return;
     const Body& b = sim.bodies[size_t(body_)];
     const Params& mat = b.params.section("material");
     if (!mat.has("E")) {

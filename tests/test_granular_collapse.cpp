@@ -95,3 +95,17 @@ TEST_CASE("friction boundary: a block sliding on the base decelerates at mu g",
   CHECK(std::fabs(v_free - 1.0) < 1e-9);
   CHECK(std::fabs(v_fric / expected - 1) < 0.15);
 }
+
+TEST_CASE("granular collapse 2D: an unknown body in verify is a located error naming the bodies",
+          "[verification][cli]") {
+  loam_test::TempDir dir("granular_collapse_bad");
+  auto r = loam_test::run_loam("run " + std::string(LOAM_SOURCE_DIR) +
+                               "/configs/granular_collapse_2d.yaml --quiet --out " +
+                               dir.path.string() + " --set verify.body=snad");
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 2);
+  CHECK(r.output ==
+        "<--set verify.body=snad>:1:1: error: verify.body: unknown body 'snad'; "
+        "bodies are: sand\n");
+  CHECK_FALSE(std::filesystem::exists(dir.path));
+}
