@@ -111,19 +111,8 @@ class Point {
   double stress(int c) const { return sim_->particles.col(sim_->particles.stress, c)[0]; }
 
   /// Every field value of the particle, to retry an increment from the same state.
-  std::vector<double> save() const {
-    std::vector<double> s;
-    const auto& P = sim_->particles;
-    for (int f = 0; f < P.num_fields(); ++f)
-      for (int c = 0; c < P.info(f).components; ++c) s.push_back(P.col(f, c)[0]);
-    return s;
-  }
-  void restore(const std::vector<double>& s) {
-    auto& P = sim_->particles;
-    size_t k = 0;
-    for (int f = 0; f < P.num_fields(); ++f)
-      for (int c = 0; c < P.info(f).components; ++c) P.col(f, c)[0] = s[k++];
-  }
+  std::vector<double> save() const { return sim_->particles.state_of(0); }
+  void restore(const std::vector<double>& s) { sim_->particles.restore_state(0, s); }
 
   /// One step as a scheme does it: V *= det(I + L dt), then the material's stress update.
   void step(const Mat3& L, double dt) {

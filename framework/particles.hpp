@@ -134,6 +134,20 @@ class Particles {
     return h;
   }
 
+  /// Every field value of particle i (all components, field order), e.g. to retry a material
+  /// update from the same state; restore_state writes such a snapshot back.
+  std::vector<double> state_of(size_t i) const {
+    std::vector<double> s;
+    for (const auto& f : fields_)
+      for (const auto& c : f.data) s.push_back(c[i]);
+    return s;
+  }
+  void restore_state(size_t i, const std::vector<double>& s) {
+    size_t k = 0;
+    for (auto& f : fields_)
+      for (auto& c : f.data) c[i] = s[k++];
+  }
+
   size_t bytes_per_particle() const {
     size_t b = sizeof(uint32_t) + 2 * sizeof(uint16_t);
     for (const auto& f : fields_) b += sizeof(double) * size_t(f.info.components);

@@ -292,23 +292,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     StencilBlock<D>& st = sc.stencil;
     sim.shape->evaluate(sim.grid, P, b, count, st);
     const int npp = NPP ? NPP : st.npp;
-    const double* g = node_.data();
     double max_v2 = sc.max_v2;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      double vn[D] = {}, wn[D] = {}, as[D] = {}, aw[D] = {};
-      for (int k = 0; k < npp; ++k) {
-        const size_t kp = size_t(k) * kBlock + size_t(p);
-        const double w = st.w[kp];
-        const double* r = g + size_t(st.node[kp]) * S;
-        for (int d = 0; d < D; ++d) {
-          vn[d] += w * r[kV + d];
-          wn[d] += w * r[kW + d];
-          as[d] += w * r[kF + d];
-          aw[d] += w * r[kFw + d];
-        }
-      }
-      max_v2 = std::max(max_v2, flip_update(P, i, dt, vn, wn, as, aw));
+      max_v2 = std::max(max_v2, velocity_update(P, st, p, i, npp, dt));
       const double ms = P.col(P.mass)[i], mw = P.col(n_)[i] * rho_w_ * P.col(P.volume)[i];
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -339,10 +326,22 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     sim.constrain(NodalVector{remap_.data(), 2 * D, D});
   }
 
-  /// FLIP/PIC update of v and w of particle i and its move with the solid grid velocity;
-  /// returns |v|^2.
-  double flip_update(Particles<D>& P, size_t i, double dt, const double (&vn)[D],
-                     const double (&wn)[D], const double (&as)[D], const double (&aw)[D]) {
+  /// Particle p (index i) of a block: FLIP/PIC update of v and w from the grid record and its move
+  /// with the solid grid velocity; returns |v|^2.
+  double velocity_update(Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
+                         double dt) {
+    double vn[D] = {}, wn[D] = {}, as[D] = {}, aw[D] = {};
+    for (int k = 0; k < npp; ++k) {
+      const size_t kp = size_t(k) * kBlock + size_t(p);
+      const double w = st.w[kp];
+      const double* r = node_.data() + size_t(st.node[kp]) * S;
+      for (int d = 0; d < D; ++d) {
+        vn[d] += w * r[kV + d];
+        wn[d] += w * r[kW + d];
+        as[d] += w * r[kF + d];
+        aw[d] += w * r[kFw + d];
+      }
+    }
     double v2 = 0;
     for (int d = 0; d < D; ++d) {
       double& v = P.col(P.velocity, d)[i];
@@ -370,21 +369,15 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       for (int c = 0; c < D * D; ++c) F[size_t(c)] = P.col(F_, c) + b;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      double ls[D][D] = {}, lw[D][D] = {}, vn[D] = {}, wn[D] = {}, as[D] = {}, aw[D] = {};
+      // USL: the velocity update happens here; MUSL did it in the re-map pass.
+      if constexpr (!REMAPPED) max_v2 = std::max(max_v2, velocity_update(P, st, p, i, npp, dt));
+      double ls[D][D] = {}, lw[D][D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
-        const double w = st.w[kp];
         const double* r = g + size_t(st.node[kp]) * S;
         // Velocities whose gradients are taken: re-mapped (MUSL) or updated grid ones (USL).
         const double* vs = REMAPPED ? remap_.data() + size_t(st.node[kp]) * 2 * D : r + kV;
         const double* vw = REMAPPED ? vs + D : r + kW;
-        if constexpr (!REMAPPED)
-          for (int d = 0; d < D; ++d) {
-            vn[d] += w * r[kV + d];
-            wn[d] += w * r[kW + d];
-            as[d] += w * r[kF + d];
-            aw[d] += w * r[kFw + d];
-          }
         for (int j = 0; j < D; ++j) {
           const double gj = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
           for (int d = 0; d < D; ++d) {
@@ -393,7 +386,6 @@ class TwoPhaseSinglePoint : public Scheme<D> {
           }
         }
       }
-      if constexpr (!REMAPPED) max_v2 = std::max(max_v2, flip_update(P, i, dt, vn, wn, as, aw));
       double trs = 0, trw = 0;
       for (int d = 0; d < D; ++d) {
         trs += ls[d][d];

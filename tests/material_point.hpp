@@ -98,19 +98,8 @@ struct MaterialPoint {
   }
 
   /// Every component of every particle field of the point, in field order.
-  std::vector<double> save() const {
-    const auto& P = sim->particles;
-    std::vector<double> s;
-    for (int f = 0; f < P.num_fields(); ++f)
-      for (int c = 0; c < P.info(f).components; ++c) s.push_back(P.col(f, c)[0]);
-    return s;
-  }
-  void restore(const std::vector<double>& s) {
-    auto& P = sim->particles;
-    size_t i = 0;
-    for (int f = 0; f < P.num_fields(); ++f)
-      for (int c = 0; c < P.info(f).components; ++c) P.col(f, c)[0] = s[i++];
-  }
+  std::vector<double> save() const { return sim->particles.state_of(0); }
+  void restore(const std::vector<double>& s) { sim->particles.restore_state(0, s); }
 
   /// Mean pressure, compression positive.
   double p() { return -(stress(0) + stress(1) + stress(2)) / 3; }
