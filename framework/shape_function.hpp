@@ -52,6 +52,10 @@ class ShapeFunction {
   /// rows_below/rows_above). A shape function that cannot continue (a particle domain too
   /// distorted, ...) sets Simulation::failure; the run then stops with exit code 3.
   virtual void begin_step(Simulation<D>&) {}
+  /// Whether the stencil of a particle reaches the whole particle domain (GIMP, CPDI, B-splines;
+  /// not the linear hats, which see only the particle's cell). Loads applied on the particle's
+  /// surface rather than at its centre need it, or they could land on nodes without mass.
+  virtual bool stencil_covers_domain() const { return true; }
   /// Fill `out` for particles [begin, begin + count), count <= kBlock. Stencil entries for nodes
   /// outside the grid must carry a valid node index with zero weight and gradient.
   virtual void evaluate(const Grid<D>& grid, const Particles<D>& particles, size_t begin, int count,

@@ -31,6 +31,9 @@
 //      conserved, so n <- 1 - (1 - n)/J; p <- p - dt K_w/n [ (1 - n) tr L_s + n tr L_w ] (storage
 //      equation, eq. 15) and the material updates sigma' with L_s (Jaumann rate), one call per
 //      block.
+//   5. pressure_smoothing: cell (default): every particle of a grid cell takes the cell's
+//      volume-weighted mean pore pressure (see apply_pressure_increment: without it the
+//      pressure checkerboards once particles cross cells).
 // Time step: the CFL limit with the undrained P-wave speed sqrt((M + K_w/n)/rho_sat) and the
 // water wave speed sqrt(K_w/rho_w); no drag limit (implicit drag).
 #include <omp.h>
@@ -69,6 +72,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
              "(robust where nodes are nearly empty, e.g. a moving drained surface); usl: from "
              "the updated grid velocities directly (one pass less)")
         .def("musl");
+    s.choice("pressure_smoothing", {"cell", "none"},
+             "cell: after every step each particle of a grid cell takes the cell's "
+             "volume-weighted mean pore pressure (one pressure per cell; removes the "
+             "particle-to-particle pressure checkerboard that appears once particles cross "
+             "cells); none: every particle keeps its own pressure")
+        .def("cell");
     s.real("flip", "-", "FLIP fraction of the particle velocity update (1: FLIP, 0: PIC)")
         .def("1")
         .min(0)
@@ -80,7 +89,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         n0_(p.real("porosity")),
         Kw_(p.real("water_bulk_modulus")),
         flip_(p.real("flip")),
-        musl_(p.text("update") == "musl") {}
+        musl_(p.text("update") == "musl"),
+        smooth_(p.text("pressure_smoothing") == "cell") {}
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     auto& P = sim.particles;
@@ -96,6 +106,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     }
     drag_->setup(sim, diag);
     node_.assign(sim.grid.num_nodes * S, 0.0);
+    dp_.assign(P.size(), 0.0);
+    if (smooth_) cell_.assign(sim.grid.num_cells * 2, 0.0);
     if (musl_) remap_.assign(sim.grid.num_nodes * 2 * D, 0.0);
     const int npp = sim.shape->nodes_per_particle();
     scratch_ = per_thread_scratch<Scratch>(sim.threads, [&](Scratch& s) {
@@ -153,6 +165,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
           sim.gather_blocks([&](size_t b, int c, int t) { update<NPP, false>(sim, dt, b, c, t); });
         });
       }
+      sim.timed("pore_pressure", [&] { apply_pressure_increment(sim); });
       double m = 0;
       for (auto& s : scratch_) m = std::max(m, s->max_v2);
       sim.max_speed = std::sqrt(m);
@@ -179,6 +192,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   std::vector<double> remap_;  // MUSL: per node solid then water velocity (2 D values)
   int w_ = -1, n_ = -1, p_ = -1, F_ = -1;
   std::vector<double> node_;
+  // Pore-pressure increments of the step and, per grid cell, the volume-weighted sum of the
+  // updated pressures and the volume (pressure_smoothing: cell).
+  std::vector<double> dp_, cell_;
+  bool smooth_ = true;
   struct alignas(64) Scratch {
     StencilBlock<D> stencil;
     std::vector<double> L, Q;
@@ -186,6 +203,50 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     long bad_porosity = -1;  // a particle whose porosity left (0, 1) this step
   };
   std::vector<std::unique_ptr<Scratch>> scratch_;
+
+  /// Add the storage-equation increments dp_ to the particles' pore pressure and, with
+  /// pressure_smoothing: cell, give every particle of a grid cell the cell's volume-weighted
+  /// mean. Without it the pressure field has one degree of freedom per particle against one
+  /// velocity per node: a pressure alternating from particle to particle exerts (nearly) no
+  /// nodal force, so nothing restrains it, and once particles cross cells the storage equation
+  /// feeds it (soft column of issue 6: +-2 MPa under a 50 kPa load, then the porosity leaves
+  /// (0, 1)). One pressure per cell is the constant-pressure (Q1-P0) element of mixed finite
+  /// elements and the element-wise liquid-pressure smoothing of the Anura3D v-w code; it
+  /// conserves the volume integral of p in each cell. Averaging only the increments is not
+  /// enough: the checkerboard left by particles that change cells stays frozen (+-9 kPa).
+  void apply_pressure_increment(Simulation<D>& sim) {
+    Particles<D>& P = sim.particles;
+    const long np = long(P.size());
+    double* p = P.col(p_);
+    if (!smooth_) {
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+      for (long i = 0; i < np; ++i) p[i] += dp_[size_t(i)];
+      return;
+    }
+    const Grid<D>& grid = sim.grid;
+    auto cell_of = [&](size_t i) {
+      size_t c = 0;
+      for (int d = 0; d < D; ++d)
+        c += size_t(grid.cell_of(P.col(P.position, d)[i], d)) * size_t(grid.cell_stride[d]);
+      return c;
+    };
+    std::fill(cell_.begin(), cell_.end(), 0.0);
+    // A particle's cell lies inside its node stencil, so the race-free colouring of the
+    // scatter covers the cell sums too.
+    sim.scatter_blocks([&](size_t b, int count, int) {
+      for (size_t i = b; i < b + size_t(count); ++i) {
+        const size_t c = cell_of(i);
+        const double V = P.col(P.volume)[i];
+        cell_[2 * c] += V * (p[i] + dp_[i]);
+        cell_[2 * c + 1] += V;
+      }
+    });
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+    for (long i = 0; i < np; ++i) {
+      const size_t c = cell_of(size_t(i));
+      p[i] = cell_[2 * c] / cell_[2 * c + 1];
+    }
+  }
 
   template <int NPP>
   void scatter(Simulation<D>& sim, size_t b, int count, int thread) {
@@ -399,7 +460,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       double& n = P.col(n_)[i];
       const double n_old = n;
       n = 1 - (1 - n) / J;
-      P.col(p_)[i] -= dt * Kw_ / n_old * ((1 - n_old) * trs + n_old * trw);
+      dp_[i] = -dt * Kw_ / n_old * ((1 - n_old) * trs + n_old * trw);
       if (!(n > 0 && n < 1)) sc.bad_porosity = long(i);
     }
     sc.max_v2 = max_v2;

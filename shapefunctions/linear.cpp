@@ -16,6 +16,7 @@ class Linear : public ShapeFunction<D> {
   int nodes_per_particle() const override { return 1 << D; }
   int rows_below() const override { return 0; }
   int rows_above() const override { return 1; }
+  bool stencil_covers_domain() const override { return false; }
 
   void evaluate(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
                 StencilBlock<D>& out) const override {
