@@ -64,6 +64,12 @@ Schema config_schema() {
         .above(0)
         .max(1);
     t.real("dt", "s", "fixed time step (overrides cfl)").positive();
+    t.integer("max_steps",
+              "step budget: a run whose first stable time step would need more steps to reach "
+              "`end` is rejected before it starts, and a run whose time step collapses stops "
+              "when it reaches the budget (exit 3)")
+        .def("100000000")
+        .min(1);
     s.section("time", t, "time integration").required();
   }
   {

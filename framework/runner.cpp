@@ -353,6 +353,12 @@ class Run {
       sim.scheme->step(sim, dt);
       sim.time += dt;
       ++sim.step;
+      if (sim.step >= sim.max_steps && sim.time < t_end * (1 - 1e-12)) {
+        failure = "time.max_steps = " + std::to_string(sim.max_steps) +
+                  " reached before t = " + format_number(t_end) + " s; the time step fell to " +
+                  format_number(dt) + " s (it was " + format_number(dt_max) + " s at most)";
+        break;
+      }
       bool frame_due = files && ((every_steps && sim.step % every_steps == 0) ||
                                  (every_time > 0 && sim.time >= next_frame_time * (1 - 1e-9)));
       bool last = sim.time >= t_end * (1 - 1e-12) || sim.step == opt_.max_steps;

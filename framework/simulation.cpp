@@ -25,6 +25,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   end_time = t.real("end");
   cfl = t.real("cfl");
   fixed_dt = t.has("dt") ? t.real("dt") : 0.0;
+  max_steps = long(t.integer("max_steps"));
   const Params& num = config.section("numerics");
   sort_every = int(num.integer("sort_every"));
   mass_tolerance = num.real("mass_tolerance");
@@ -67,6 +68,17 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
     for (size_t i = 0; i < particles.size(); ++i) v2 = std::max(v2, v[i] * v[i]);
   }
   max_speed = std::sqrt(v2);
+  // Step budget: a stiff set-up (e.g. K_w / n with a porosity near 0) can make the stable time
+  // step so small that the run would never finish; say so before writing anything.
+  const double dt0 = stable_dt();
+  if (end_time / dt0 > double(max_steps))
+    diag.error(t.where("end"), t.path("end"),
+               "the stable time step at the start is " + format_number(dt0) + " s, so " +
+                   format_number(end_time) + " s needs about " +
+                   format_number(std::ceil(end_time / dt0)) +
+                   " steps, more than time.max_steps = " + std::to_string(max_steps) +
+                   " (a stiff material or pore fluid, e.g. K_w / n with a tiny porosity, or a "
+                   "fine grid); raise time.max_steps if this is intended");
 }
 
 template <int D>

@@ -67,6 +67,7 @@ class Simulation {
 
   Vec gravity{};
   double time = 0, dt = 0, end_time = 0, cfl = 0.5, fixed_dt = 0;
+  long max_steps = 100000000;  // time.max_steps
   long step = 0;
   int threads = 1;
   int sort_every = 20;
