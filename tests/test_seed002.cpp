@@ -73,7 +73,7 @@ void check_late_times(const Seed002& r) {
 
 }  // namespace
 
-TEST_CASE("seed 002: fixed base: Terzaghi at late times; the undrained wave doubles at the base",
+TEST_CASE("seed 002: fixed base: Terzaghi at late times, the undrained wave doubles at the base",
           "[verification][two_phase]") {
   // References: Terzaghi (late times, tolerance 0.03, see check_late_times). The undrained wave
   // (c_u = 656 m/s, arrival 1.5 ms) carries p = B p0 = 0.99 p0; reflected at the rigid
