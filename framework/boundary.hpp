@@ -1,6 +1,8 @@
 #pragma once
 // Boundary-condition plugin interface: constrains nodal velocity (and acceleration) components.
-// Schemes call constrain() on every nodal vector that must respect the constraint.
+// Schemes call constrain() on every nodal vector that must respect the constraint, and
+// constrain_grid_update() once on the grid update of a step (all phases, with nodal masses).
+#include <array>
 #include <string>
 #include <vector>
 
@@ -12,6 +14,23 @@ template <int D>
 class Simulation;
 class Diagnostics;
 class Params;
+
+/// One phase of a grid update: the updated nodal velocity v^{n+1}, the acceleration a with
+/// v^{n+1} = v^n + dt a, and the phase's lumped nodal mass mass.at(n, 0) (kg; per unit area in
+/// 1D and per unit thickness in 2D, like the particle masses). Nodes with no mass have zero
+/// velocity and acceleration.
+struct PhaseUpdate {
+  NodalVector velocity, acceleration, mass;
+};
+
+/// The grid update of one step, after the scheme's own implicit terms (e.g. drag). phases[0] is
+/// the scheme's only phase or the solid skeleton; phases[1], when count == 2, is the pore water
+/// of a two-phase scheme (its velocity is the water's own, not relative to the skeleton).
+struct GridUpdate {
+  std::array<PhaseUpdate, 2> phases;
+  int count = 1;
+  double dt = 0;
+};
 
 template <int D>
 class Boundary {
@@ -27,6 +46,13 @@ class Boundary {
   virtual void constrain_update(const NodalVector& v, const NodalVector& a, double /*dt*/) const {
     constrain(v);
     constrain(a);
+  }
+  /// The whole grid update of a step: every phase at once, with the nodal masses. A condition
+  /// that applies a force integrated implicitly (a dashpot: v^{n+1} = m v* / (m + dt C) needs m)
+  /// or that couples the phases overrides this. Default: constrain_update of each phase.
+  virtual void constrain_grid_update(const GridUpdate& u) const {
+    for (int k = 0; k < u.count; ++k)
+      constrain_update(u.phases[size_t(k)].velocity, u.phases[size_t(k)].acceleration, u.dt);
   }
 };
 

@@ -23,7 +23,8 @@
 namespace loam {
 
 /// Bumped when a plugin base interface changes; out-of-tree plugins check it.
-constexpr int kPluginAbiVersion = 1;
+/// 2: Boundary::constrain_grid_update (all phases of a grid update, with nodal masses).
+constexpr int kPluginAbiVersion = 2;
 
 struct PluginInfo {
   std::string kind, name, summary;

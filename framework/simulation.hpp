@@ -95,9 +95,10 @@ class Simulation {
   void constrain(const NodalVector& v) const {
     for (const auto& b : boundaries) b->constrain(v);
   }
-  /// Apply every boundary condition to the updated nodal velocity and acceleration.
-  void constrain_update(const NodalVector& v, const NodalVector& a, double dt) const {
-    for (const auto& b : boundaries) b->constrain_update(v, a, dt);
+  /// Apply every boundary condition to the grid update of a step (velocities, accelerations
+  /// and nodal masses of every phase), in the order the config lists them.
+  void constrain_update(const GridUpdate& u) const {
+    for (const auto& b : boundaries) b->constrain_grid_update(u);
   }
   /// The material stress update of one block [b, b + count) (one material per block), with
   /// its velocity gradient L in block layout (MaterialBatch).

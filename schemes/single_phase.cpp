@@ -157,7 +157,10 @@ class SinglePhase : public Scheme<D> {
         for (int d = 0; d < 2 * D; ++d) r[1 + d] = 0.0;
       }
     }
-    sim.constrain_update(node_vector(1), node_vector(1 + D), dt);
+    GridUpdate u;
+    u.phases[0] = {node_vector(1), node_vector(1 + D), node_vector(0)};
+    u.dt = dt;
+    sim.constrain_update(u);
   }
 
   /// Velocity from momentum in vel_ (MUSL re-map, USF), constrained.

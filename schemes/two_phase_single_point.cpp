@@ -20,7 +20,9 @@
 //      (a 2x2 solve, unconditionally stable in Q, so low permeability does not shrink the time
 //      step). Boundary conditions act on both phases (a fixed or slip face is impermeable: the
 //      water cannot cross it either); a face without a condition is free and drained (p = 0
-//      is the natural condition of the water equation).
+//      is the natural condition of the water equation). They receive both phases of the update
+//      at once, with the nodal solid and water masses (Boundary::constrain_grid_update), so a
+//      condition may couple the phases or apply implicit forces (e.g. absorbing dashpots).
 //   3. grid -> particle: FLIP/PIC update of v and w from the grid accelerations, positions move
 //      with the solid grid velocity. `update: musl` (default) then re-maps the new particle
 //      momenta of both phases to the grid (Sulsky 1995), and the gradients below use those
@@ -338,8 +340,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         r[kFw + d] = (wn - w) / dt;
       }
     }
-    sim.constrain_update(NodalVector{g, S, kV}, NodalVector{g, S, kF}, dt);
-    sim.constrain_update(NodalVector{g, S, kW}, NodalVector{g, S, kFw}, dt);
+    GridUpdate u;
+    u.phases[0] = {NodalVector{g, S, kV}, NodalVector{g, S, kF}, NodalVector{g, S, kMs}};
+    u.phases[1] = {NodalVector{g, S, kW}, NodalVector{g, S, kFw}, NodalVector{g, S, kMw}};
+    u.count = 2;
+    u.dt = dt;
+    sim.constrain_update(u);
   }
 
   /// Grid to particles: velocities (FLIP/PIC), positions, gradients, volume, porosity, pore

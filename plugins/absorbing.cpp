@@ -1,0 +1,150 @@
+// Viscous absorbing grid face (Lysmer & Kuhlemeyer 1969): dashpots on the nodes of one face so
+// that waves leave the grid instead of reflecting, as if the material continued beyond the face.
+// Per unit face area the face applies the tractions
+//     t_n = -rho c_p v_n   (normal),        t_t = -rho c_s v_t   (tangential),
+// with rho, c_p, c_s the density and P- and S-wave speeds of the material next to the face (given
+// explicitly: this plugin reads nothing from the materials). For a plane wave at normal incidence
+// this is exact: the impedance rho c_p of the material is matched and nothing is reflected.
+//
+// Per node the dashpot coefficient is C = rho c A, A the node's tributary area of the face: the
+// product of the cell sizes along the face's other axes, halved for each axis along which the node
+// lies on the grid's edge (1D: A = 1, since masses are per unit area; 2D: A = h or h/2 per unit
+// thickness, since masses are per unit thickness; 3D: h1 h2, h1 h2 / 2 or h1 h2 / 4).
+//
+// The dashpot is integrated implicitly, so it is stable for any C: with m the lumped nodal mass and
+// v* the velocity the scheme's update gave without the dashpot, m v^{n+1} = m v* - dt C v^{n+1},
+//     v^{n+1} = m v* / (m + dt C)
+// per damped component, and the acceleration is kept consistent with it, a += (v^{n+1} - v*)/dt,
+// so that FLIP particle updates see the dashpot too. The face is otherwise free. A dashpot cannot
+// carry a static load: a body pressed onto the face drifts at v = t / (rho c_p).
+//
+// Two-phase schemes (solid and pore water, e.g. two_phase_single_point): the face is an
+// IMPERMEABLE dashpot, as the viscous bottom of seed 002's consolidation column (an impervious
+// base with extra damping): water does not cross the face relative to the skeleton, so the normal
+// velocities of solid and water at a face node are equal, and the mixture's normal dashpot acts on
+// that common velocity with the mixture's momentum,
+//     v_n^{n+1} = w_n^{n+1} = (m_s v_n* + m_w w_n*) / (m_s + m_w + dt C_n),   C_n = rho c_p A,
+// while the tangential dashpot acts on the skeleton only (water carries no shear stress),
+//     v_t^{n+1} = m_s v_t* / (m_s + dt C_t),   C_t = rho c_s A,   w_t unchanged.
+// Here rho is the saturated density rho_sat = (1 - n) rho_s + n rho_w, c_p the UNDRAINED P-wave
+// speed sqrt((M + K_w / n) / rho_sat) and c_s = sqrt(G / rho_sat). This is the Lysmer-Kuhlemeyer
+// condition of the undrained mixture, the low-frequency limit of Biot's theory (drag couples the
+// phases: wave periods long against rho_w k / (n gamma_w)); there the total traction of an
+// outgoing plane wave is exactly -rho_sat c_u v_n. Faster (higher-frequency) Biot P-waves and the
+// slow wave are absorbed only approximately. Seed 002 does not give its dashpot's equations.
+//
+// Measured reflections (tests/test_absorbing.cpp, peak reflected over peak incident): a half-sine
+// pulse 20 cells long in an elastic bar, 2.6 % (linear, cpdi) to 3.7 % (bspline2), 2.6 % in 2D
+// (a fixed face: 98-105 %); the seed 002 column's undrained wave 2.5 % (fixed base: 90 %), and
+// 7 % with 100 times its permeability, where the wave is no longer undrained.
+#include <algorithm>
+#include <cmath>
+
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+
+namespace loam {
+
+template <int D>
+class Absorbing : public Boundary<D> {
+ public:
+  static constexpr const char* name = "absorbing";
+  static constexpr const char* summary =
+      "viscous absorbing grid face (Lysmer-Kuhlemeyer dashpots rho c_p normal, rho c_s "
+      "tangential, implicit; two-phase: impermeable, undrained mixture impedance)";
+  static Schema schema() {
+    Schema s;
+    s.choice("face", face_names(), "grid face carrying the dashpots").required();
+    s.real("density", "kg/m^3",
+           "mass density rho of the material next to the face (two-phase: saturated density "
+           "(1 - n) rho_s + n rho_w)")
+        .required()
+        .positive();
+    s.real("p_wave_speed", "m/s",
+           "P-wave speed c_p = sqrt(M / rho) of that material, M = E (1 - nu) / ((1 + nu) "
+           "(1 - 2 nu)) the constrained modulus (two-phase: the undrained speed sqrt((M + K_w / n) "
+           "/ rho_sat)); normal dashpot rho c_p per unit area")
+        .required()
+        .positive();
+    s.real("s_wave_speed", "m/s",
+           "S-wave speed c_s = sqrt(G / rho), G = E / (2 (1 + nu)) (two-phase: G / rho_sat); "
+           "tangential dashpot rho c_s per unit area, 0 for none; required in 2D and 3D")
+        .non_negative();
+    return s;
+  }
+  explicit Absorbing(const Params& p)
+      : params_(p),
+        face_(parse_face(p.text("face"))),
+        normal_(p.real("density") * p.real("p_wave_speed")),
+        tangential_(p.has("s_wave_speed") ? p.real("density") * p.real("s_wave_speed") : 0.0) {}
+
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    if (!check_face(face_, D, params_, "face", diag)) return;
+    if (D > 1 && !params_.has("s_wave_speed"))
+      diag.error(params_.where(), params_.path("s_wave_speed"),
+                 "missing required key 's_wave_speed' in " + std::to_string(D) +
+                     "D (S-wave speed for the tangential dashpots, m/s; 0 for none)");
+    const Grid<D>& g = sim.grid;
+    nodes_ = face_nodes(g, face_);
+    area_.resize(nodes_.size());
+    for (size_t k = 0; k < nodes_.size(); ++k) {
+      const auto ijk = g.node_ijk(nodes_[k]);
+      double a = 1;
+      for (int d = 0; d < D; ++d) {
+        if (d == face_.axis) continue;
+        const bool edge = ijk[size_t(d)] == 0 || ijk[size_t(d)] == g.nodes[size_t(d)] - 1;
+        a *= g.cell[size_t(d)] * (edge ? 0.5 : 1.0);
+      }
+      area_[k] = a;
+    }
+  }
+
+  /// A dashpot constrains no momentum, force or re-mapped velocity: it acts in the update only.
+  void constrain(const NodalVector&) const override {}
+
+  void constrain_grid_update(const GridUpdate& u) const override {
+    const double dt = u.dt;
+    if (!(dt > 0)) return;
+    const int ax = face_.axis;
+    const PhaseUpdate& s = u.phases[0];
+    for (size_t k = 0; k < nodes_.size(); ++k) {
+      const size_t n = nodes_[k];
+      const double ms = s.mass.at(n, 0);
+      if (!(ms > 0)) continue;  // the scheme left this node at rest
+      const double cn = dt * normal_ * area_[k], ct = dt * tangential_ * area_[k];
+      for (int d = 0; d < D; ++d) {
+        if (d == ax && u.count == 2) continue;  // normal of a two-phase update: below
+        damp(s, n, d, ms / (ms + (d == ax ? cn : ct)), dt);
+      }
+      if (u.count == 2) {
+        // Impermeable: solid and water share the normal velocity; mixture dashpot on it.
+        const PhaseUpdate& w = u.phases[1];
+        const double mw = w.mass.at(n, 0);
+        const double vs = s.velocity.at(n, ax), vw = w.velocity.at(n, ax);
+        const double vn = (ms * vs + std::max(mw, 0.0) * vw) / (ms + std::max(mw, 0.0) + cn);
+        s.velocity.at(n, ax) = vn;
+        s.acceleration.at(n, ax) += (vn - vs) / dt;
+        w.velocity.at(n, ax) = vn;
+        w.acceleration.at(n, ax) += (vn - vw) / dt;
+      }
+    }
+  }
+
+ private:
+  /// v <- factor v for component d of node n, with a consistent acceleration.
+  static void damp(const PhaseUpdate& p, size_t n, int d, double factor, double dt) {
+    const double before = p.velocity.at(n, d), after = factor * before;
+    p.velocity.at(n, d) = after;
+    p.acceleration.at(n, d) += (after - before) / dt;
+  }
+
+  Params params_;
+  Face face_;
+  double normal_, tangential_;  // rho c_p and rho c_s (Pa s/m)
+  std::vector<size_t> nodes_;
+  std::vector<double> area_;  // tributary face area per node (m^(D-1))
+};
+
+LOAM_REGISTER(Boundary, Absorbing)
+
+}  // namespace loam
