@@ -1,0 +1,103 @@
+// Reference: final settlement of a laterally confined column under a surface load, for any
+// skeleton material (seed 001 MCC, VERIFICATION.md C "Seed 001 MCC"). It measures; the value to
+// compare with comes from elsewhere (for an elastoplastic skeleton: the oedometric element test
+// of the same material from the same initial state to the same final vertical effective stress,
+// `loam element-test`, given here as expected_settlement).
+//   final_height     = sum V_p / A0, A0 = V0 / H0 (m): the column's current volume over its
+//                      initial cross-section (counts the half particle beyond the outermost
+//                      centres at both faces, as consolidated_height does)
+//   final_settlement = H0 - final_height (m), H0 the initial height of the body along the last
+//                      axis (the vertical of a 1D, 2D or 3D column)
+// For a uniform column h / H0 = V / V0 = (1 + e) / (1 + e0), so final_settlement / H0 equals
+// the element test's 1 - exp(-eps_a) (eps_a its logarithmic axial strain).
+// Metrics (at the end of the run): final_height, final_settlement (m), vertical_stress (Pa, the
+// volume-weighted mean effective stress along the last axis over the body, COMPRESSION POSITIVE;
+// the applied load plus any initial stress once drained), residual_pore_pressure (max |p| / load
+// over the body, p the excess pore pressure; near 0 once consolidation is complete; only with a
+// two-phase scheme), and when given: settlement_error = (final_settlement - expected) / expected,
+// paper_settlement and settlement_vs_paper (relative).
+#include <cmath>
+
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+
+namespace loam {
+
+template <int D>
+class Settlement : public Reference<D> {
+ public:
+  static constexpr const char* name = "settlement";
+  static constexpr const char* summary =
+      "final settlement H0 - sum V / A0 of a confined column under a surface load, against an "
+      "expected value (e.g. an oedometric element test) and residual pore pressure";
+  static Schema schema() {
+    Schema s;
+    s.real("load", "Pa",
+           "surface load added at the start (compression positive); scales residual_pore_pressure")
+        .required()
+        .positive();
+    s.real("expected_settlement", "m",
+           "settlement to compare with, e.g. H0 (1 - exp(-eps_a)) from the oedometric element "
+           "test of the same material (optional; gives settlement_error)")
+        .positive();
+    s.real("paper_settlement", "m", "a published final settlement to report beside (optional)")
+        .positive();
+    s.text("body", "the column (default: the first body)");
+    return s;
+  }
+  explicit Settlement(const Params& p) : params_(p) {}
+
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    body_ = sim.body_param(params_, "body", diag);
+    if (body_ < 0) return;
+    const Body& b = sim.bodies[size_t(body_)];
+    H0_ = b.upper[D - 1] - b.lower[D - 1];
+    V0_ = sum(sim, [&](size_t i) { return sim.particles.col(sim.particles.volume)[i]; });
+    pore_ = sim.particles.find("pore_pressure");
+  }
+
+  std::map<std::string, double> metrics(Simulation<D>& sim) override {
+    const auto& P = sim.particles;
+    const double* V = P.col(P.volume);
+    const double* sv = P.col(P.stress, D - 1);  // normal stress along the last axis
+    std::map<std::string, double> m;
+    const double vol = sum(sim, [&](size_t i) { return V[i]; });
+    const double h = vol / (V0_ / H0_), s = H0_ - h;
+    m["final_height"] = h;
+    m["final_settlement"] = s;
+    m["vertical_stress"] = -sum(sim, [&](size_t i) { return V[i] * sv[i]; }) / vol;
+    if (pore_ >= 0) {
+      double worst = 0;
+      for (size_t i = 0; i < P.size(); ++i)
+        if (P.body[i] == body_) worst = std::max(worst, std::fabs(P.col(pore_)[i]));
+      m["residual_pore_pressure"] = worst / params_.real("load");
+    }
+    if (params_.has("expected_settlement")) {
+      m["expected_settlement"] = params_.real("expected_settlement");
+      m["settlement_error"] = (s - m["expected_settlement"]) / m["expected_settlement"];
+    }
+    if (params_.has("paper_settlement")) {
+      m["paper_settlement"] = params_.real("paper_settlement");
+      m["settlement_vs_paper"] = (s - m["paper_settlement"]) / m["paper_settlement"];
+    }
+    return m;
+  }
+
+ private:
+  template <class F>
+  double sum(const Simulation<D>& sim, F&& value) const {
+    const auto& P = sim.particles;
+    double total = 0;
+    for (size_t i = 0; i < P.size(); ++i)
+      if (P.body[i] == body_) total += value(i);
+    return total;
+  }
+
+  Params params_;
+  int body_ = 0, pore_ = -1;
+  double H0_ = 1, V0_ = 1;
+};
+
+LOAM_REGISTER(Reference, Settlement)
+
+}  // namespace loam
