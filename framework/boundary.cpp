@@ -36,6 +36,49 @@ std::vector<size_t> face_nodes(const Grid<D>& grid, const Face& face) {
   return out;
 }
 
+void add_phase_param(Schema& s) {
+  s.choice("phase", {"both", "solid", "water"},
+           "two-phase schemes: the phases this condition holds; both (the face is impermeable "
+           "too), solid (the water passes: drained) or water")
+      .def("both");
+}
+
+int parse_phase_mask(const Params& p) {
+  const std::string ph = p.text("phase");
+  return ph == "solid" ? 1 : ph == "water" ? 2 : 3;
+}
+
+bool check_phase_mask(int mask, int scheme_phases, const Params& p, Diagnostics& d) {
+  if (mask == 3 || scheme_phases > 1) return true;
+  d.error(p.where("phase"), p.path("phase"),
+          "phase: " + p.text("phase") +
+              " needs a two-phase scheme (this scheme has one phase on the grid)");
+  return false;
+}
+
+template <int D>
+std::vector<double> face_node_areas(const Grid<D>& g, const Face& face,
+                                    const std::vector<size_t>& nodes) {
+  std::vector<double> area(nodes.size());
+  for (size_t k = 0; k < nodes.size(); ++k) {
+    const auto ijk = g.node_ijk(nodes[k]);
+    double a = 1;
+    for (int d = 0; d < D; ++d) {
+      if (d == face.axis) continue;
+      const bool edge = ijk[size_t(d)] == 0 || ijk[size_t(d)] == g.nodes[size_t(d)] - 1;
+      a *= g.cell[size_t(d)] * (edge ? 0.5 : 1.0);
+    }
+    area[k] = a;
+  }
+  return area;
+}
+
+template std::vector<double> face_node_areas<1>(const Grid<1>&, const Face&,
+                                                const std::vector<size_t>&);
+template std::vector<double> face_node_areas<2>(const Grid<2>&, const Face&,
+                                                const std::vector<size_t>&);
+template std::vector<double> face_node_areas<3>(const Grid<3>&, const Face&,
+                                                const std::vector<size_t>&);
 template std::vector<size_t> face_nodes<1>(const Grid<1>&, const Face&);
 template std::vector<size_t> face_nodes<2>(const Grid<2>&, const Face&);
 template std::vector<size_t> face_nodes<3>(const Grid<3>&, const Face&);

@@ -30,6 +30,8 @@ struct GridUpdate {
   std::array<PhaseUpdate, 2> phases;
   int count = 1;
   double dt = 0;
+  /// Two-phase: the nodal porosity porosity.at(n, 0) (volume-weighted from the particles).
+  NodalVector porosity{nullptr, 0, 0};
 };
 
 template <int D>
@@ -49,11 +51,21 @@ class Boundary {
   }
   /// The whole grid update of a step: every phase at once, with the nodal masses. A condition
   /// that applies a force integrated implicitly (a dashpot: v^{n+1} = m v* / (m + dt C) needs m)
-  /// or that couples the phases overrides this. Default: constrain_update of each phase.
+  /// or that couples the phases overrides this. Default: constrain_update of each phase it
+  /// applies to.
   virtual void constrain_grid_update(const GridUpdate& u) const {
     for (int k = 0; k < u.count; ++k)
-      constrain_update(u.phases[size_t(k)].velocity, u.phases[size_t(k)].acceleration, u.dt);
+      if (applies_to(k))
+        constrain_update(u.phases[size_t(k)].velocity, u.phases[size_t(k)].acceleration, u.dt);
   }
+  /// Whether constrain() acts on phase k (0: the only phase or the solid, 1: the pore water).
+  virtual bool applies_to(int /*phase*/) const { return true; }
+  /// Hydraulic conditions (drained, impermeable, prescribed pore pressure) act on the water
+  /// after every mechanical condition, whatever the order of the config, and may first record
+  /// the water's unconstrained state (before_constraints) to release it on a drained face.
+  virtual bool hydraulic() const { return false; }
+  virtual void before_constraints(const GridUpdate&) {}
+  virtual void before_constrain(const NodalVector& /*v*/, int /*phase*/) {}
 };
 
 /// The nodes on one face of the grid ("x-", "x+", "y-", ...), for face-based plugins.
@@ -66,6 +78,19 @@ template <int D>
 std::vector<size_t> face_nodes(const Grid<D>& grid, const Face& face);
 /// Report a face that does not exist in this dimension; returns false then.
 bool check_face(const Face& f, int dim, const Params& p, const std::string& key, Diagnostics& d);
+/// Which phases of a two-phase scheme a mechanical face condition holds (YAML `phase`): both
+/// (default: the face is also impermeable to the water), solid (the water passes: a drained
+/// face) or water (the water is held, the skeleton free). Bit 0: solid, bit 1: water.
+class Schema;
+void add_phase_param(Schema& s);
+int parse_phase_mask(const Params& p);
+/// Report `phase: solid` or `water` under a scheme without a water phase; returns false then.
+bool check_phase_mask(int mask, int scheme_phases, const Params& p, Diagnostics& d);
+/// Tributary face area of each node of face_nodes(grid, face) (m^(D-1); 1 in 1D, where masses
+/// are per unit area): the cell sizes along the face, halved at the grid's edges.
+template <int D>
+std::vector<double> face_node_areas(const Grid<D>& grid, const Face& face,
+                                    const std::vector<size_t>& nodes);
 const std::vector<std::string>& face_names();
 
 }  // namespace loam

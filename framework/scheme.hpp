@@ -31,6 +31,8 @@ class Scheme {
     return std::numeric_limits<double>::infinity();
   }
   virtual void step(Simulation<D>&, double dt) = 0;
+  /// Phases on the grid: 1, or 2 for a scheme with a pore-water phase (boundary phase 1).
+  virtual int phases() const { return 1; }
   /// Nodal fields for optional grid output.
   virtual std::vector<GridFieldView> grid_fields() const { return {}; }
 };

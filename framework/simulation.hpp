@@ -91,14 +91,24 @@ class Simulation {
   }
 
   // --------------------------------------------------------- hooks for schemes
-  /// Apply every boundary condition to a nodal vector.
-  void constrain(const NodalVector& v) const {
-    for (const auto& b : boundaries) b->constrain(v);
+  /// Apply every boundary condition that acts on `phase` (0: the only phase or the solid, 1: the
+  /// pore water) to a nodal vector: mechanical conditions first, then hydraulic ones.
+  void constrain(const NodalVector& v, int phase = 0) const {
+    for (const auto& b : boundaries)
+      if (b->hydraulic() && b->applies_to(phase)) b->before_constrain(v, phase);
+    for (int pass = 0; pass < 2; ++pass)
+      for (const auto& b : boundaries)
+        if (b->hydraulic() == (pass == 1) && b->applies_to(phase)) b->constrain(v);
   }
   /// Apply every boundary condition to the grid update of a step (velocities, accelerations
-  /// and nodal masses of every phase), in the order the config lists them.
+  /// and nodal masses of every phase): mechanical conditions in the order the config lists
+  /// them, then the hydraulic ones.
   void constrain_update(const GridUpdate& u) const {
-    for (const auto& b : boundaries) b->constrain_grid_update(u);
+    for (const auto& b : boundaries)
+      if (b->hydraulic()) b->before_constraints(u);
+    for (int pass = 0; pass < 2; ++pass)
+      for (const auto& b : boundaries)
+        if (b->hydraulic() == (pass == 1)) b->constrain_grid_update(u);
   }
   /// The material stress update of one block [b, b + count) (one material per block), with
   /// its velocity gradient L in block layout (MaterialBatch).

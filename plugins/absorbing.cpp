@@ -86,17 +86,7 @@ class Absorbing : public Boundary<D> {
                      "D (S-wave speed for the tangential dashpots, m/s; 0 for none)");
     const Grid<D>& g = sim.grid;
     nodes_ = face_nodes(g, face_);
-    area_.resize(nodes_.size());
-    for (size_t k = 0; k < nodes_.size(); ++k) {
-      const auto ijk = g.node_ijk(nodes_[k]);
-      double a = 1;
-      for (int d = 0; d < D; ++d) {
-        if (d == face_.axis) continue;
-        const bool edge = ijk[size_t(d)] == 0 || ijk[size_t(d)] == g.nodes[size_t(d)] - 1;
-        a *= g.cell[size_t(d)] * (edge ? 0.5 : 1.0);
-      }
-      area_[k] = a;
-    }
+    area_ = face_node_areas(g, face_, nodes_);
   }
 
   /// A dashpot constrains no momentum, force or re-mapped velocity: it acts in the update only.

@@ -12,10 +12,14 @@ class Fixed : public Boundary<D> {
   static Schema schema() {
     Schema s;
     s.choice("face", face_names(), "grid face").required();
+    add_phase_param(s);
     return s;
   }
-  explicit Fixed(const Params& p) : params_(p), face_(parse_face(p.text("face"))) {}
+  explicit Fixed(const Params& p)
+      : params_(p), face_(parse_face(p.text("face"))), phases_(parse_phase_mask(p)) {}
+  bool applies_to(int phase) const override { return (phases_ >> phase) & 1; }
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    check_phase_mask(phases_, sim.scheme->phases(), params_, diag);
     if (check_face(face_, D, params_, "face", diag)) nodes_ = face_nodes(sim.grid, face_);
   }
   void constrain(const NodalVector& v) const override {
@@ -26,6 +30,7 @@ class Fixed : public Boundary<D> {
  private:
   Params params_;
   Face face_;
+  int phases_;  // bit 0 solid, bit 1 water
   std::vector<size_t> nodes_;
 };
 

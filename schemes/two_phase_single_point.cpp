@@ -94,6 +94,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         musl_(p.text("update") == "musl"),
         smooth_(p.text("pressure_smoothing") == "cell") {}
 
+  int phases() const override { return 2; }
+
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     auto& P = sim.particles;
     w_ = P.request({"water_velocity", D, "m/s", "pore water velocity", Particles<D>::axis_names()});
@@ -184,9 +186,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
 
  private:
   // Node record: solid mass, water mass, solid momentum -> velocity, water momentum ->
-  // velocity, mixture force -> solid acceleration, water force -> water acceleration, drag Q.
+  // velocity, mixture force -> solid acceleration, water force -> water acceleration, drag Q,
+  // volume -> porosity.
   static constexpr int kMs = 0, kMw = 1, kV = 2, kW = 2 + D, kF = 2 + 2 * D, kFw = 2 + 3 * D,
-                       kQ = 2 + 4 * D, S = 3 + 4 * D;
+                       kQ = 2 + 4 * D, kN = 3 + 4 * D, S = 4 + 4 * D;
   static constexpr int NS = Particles<D>::NS;
   std::unique_ptr<Drag<D>> drag_;
   double n0_, Kw_, flip_, rho_w_ = 1000;
@@ -295,6 +298,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         r[kMs] += w * ms[p];
         r[kMw] += w * mw;
         r[kQ] += w * vq;
+        r[kN] += w * V[p];  // volume; the nodal porosity m_w / (rho_w V_I) in integrate()
         double gr[D];
         for (int j = 0; j < D; ++j)
           gr[j] = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
@@ -324,6 +328,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         for (int c = kV; c < S; ++c) r[c] = 0.0;
         continue;
       }
+      r[kN] = r[kN] > 0 ? mw / (rho_w_ * r[kN]) : 0.0;
       for (int d = 0; d < D; ++d) {
         const double v = r[kV + d] / ms, w = mw > tol ? r[kW + d] / mw : v;
         const double F = r[kF + d], Fw = r[kFw + d];
@@ -345,6 +350,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     u.phases[1] = {NodalVector{g, S, kW}, NodalVector{g, S, kFw}, NodalVector{g, S, kMw}};
     u.count = 2;
     u.dt = dt;
+    u.porosity = NodalVector{g, S, kN};
     sim.constrain_update(u);
   }
 
@@ -390,7 +396,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       }
     }
     sim.constrain(NodalVector{remap_.data(), 2 * D, 0});
-    sim.constrain(NodalVector{remap_.data(), 2 * D, D});
+    sim.constrain(NodalVector{remap_.data(), 2 * D, D}, 1);
   }
 
   /// Particle p (index i) of a block: FLIP/PIC update of v and w from the grid record and its move

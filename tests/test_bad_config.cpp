@@ -144,8 +144,9 @@ time:
   end: 0.1
   steps: 100
 )");
-  require_rejected(
-      s, r, {s.error_at(10, 3, "time.steps", "unknown key 'steps'; valid keys are: end, cfl, dt")});
+  require_rejected(s, r,
+                   {s.error_at(10, 3, "time.steps",
+                               "unknown key 'steps'; valid keys are: end, cfl, dt, max_steps")});
 }
 
 TEST_CASE("misspelt key inside a body: unknown key and the missing one", "[bad_config]") {

@@ -1,0 +1,32 @@
+// Drained face of a two-phase scheme: the pore water passes the face freely, so the pore
+// pressure there is zero (the natural condition of the water's weak form, seed 001 eq. 16).
+// It releases the water from a mechanical condition on the same face: `fixed` + `drained` is a
+// fixed, drained base (a porous stone); see framework/hydraulic_face.hpp.
+#include "framework/hydraulic_face.hpp"
+#include "framework/registry.hpp"
+
+namespace loam {
+
+template <int D>
+class Drained : public HydraulicFace<D> {
+ public:
+  static constexpr const char* name = "drained";
+  static constexpr const char* summary =
+      "two-phase: the pore water leaves the grid face freely (pore pressure 0 there), even if "
+      "the skeleton is fixed on it";
+  static Schema schema() {
+    Schema s;
+    HydraulicFace<D>::add_face(s);
+    return s;
+  }
+  explicit Drained(const Params& p) : HydraulicFace<D>(p) {}
+  const char* condition() const override { return name; }
+  void before_constraints(const GridUpdate& u) override { this->record(u); }
+  void constrain_grid_update(const GridUpdate& u) const override { this->release(u); }
+  void before_constrain(const NodalVector& v, int) override { this->record(v); }
+  void constrain(const NodalVector& v) const override { this->release(v); }
+};
+
+LOAM_REGISTER(Boundary, Drained)
+
+}  // namespace loam

@@ -1,0 +1,79 @@
+// Prescribed pore pressure on a face of a two-phase scheme: p = `pressure` (Pa, compression
+// positive), or p = gamma_w (head - z) from a piezometric `head` (m; z the node's coordinate
+// along the last axis, the vertical). The water passes the face freely (as `drained`, which is
+// the case p = 0) and the face adds the boundary term of the weak forms (seed 001 eqs. 16-17):
+// with n_out the outward normal and A_I the node's tributary face area, the mixture gets the
+// total traction -p n_out A_I, of which the water equation (per unit pore volume, times the
+// nodal porosity n_I) takes -n_I p n_out A_I and the skeleton the rest, -(1 - n_I) p n_out A_I.
+// Both are applied as explicit nodal forces in the grid update (a += f/m, v += dt f/m), before
+// the mechanical conditions, so a skeleton fixed on the face stays fixed.
+#include "framework/hydraulic_face.hpp"
+#include "framework/registry.hpp"
+
+namespace loam {
+
+template <int D>
+class PrescribedPorePressure : public HydraulicFace<D> {
+ public:
+  static constexpr const char* name = "prescribed_pore_pressure";
+  static constexpr const char* summary =
+      "two-phase: pore pressure (or piezometric head) prescribed on a grid face; the water "
+      "passes it freely";
+  static Schema schema() {
+    Schema s;
+    HydraulicFace<D>::add_face(s);
+    s.real("pressure", "Pa", "pore pressure on the face (compression positive)");
+    s.real("head", "m",
+           "piezometric head: p = unit_weight * (head - z), z the vertical coordinate");
+    s.real("unit_weight", "N/m^3", "unit weight of the water gamma_w, for head")
+        .def("9810")
+        .positive();
+    s.check([](const Params& p, Diagnostics& d) {
+      if (p.has("pressure") == p.has("head"))
+        d.error(p.where(), p.path(), "give exactly one of 'pressure' or 'head'");
+    });
+    return s;
+  }
+  explicit PrescribedPorePressure(const Params& p) : HydraulicFace<D>(p) {}
+  const char* condition() const override { return name; }
+
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    HydraulicFace<D>::setup(sim, diag);
+    const Params& p = this->params_;
+    pressure_.assign(this->nodes_.size(), p.has("pressure") ? p.real("pressure") : 0.0);
+    if (p.has("head"))
+      for (size_t k = 0; k < this->nodes_.size(); ++k)
+        pressure_[k] =
+            p.real("unit_weight") * (p.real("head") - sim.grid.node_coord(this->nodes_[k], D - 1));
+  }
+  /// The face forces go in before the mechanical conditions (a fixed skeleton stays fixed);
+  /// then the water's update is recorded, to be released after them.
+  void before_constraints(const GridUpdate& u) override {
+    if (u.count < 2 || !u.porosity.base) return;
+    const int a = this->face_.axis;
+    const double out = this->face_.upper ? 1.0 : -1.0;
+    for (size_t k = 0; k < this->nodes_.size(); ++k) {
+      const size_t n = this->nodes_[k];
+      const double nI = u.porosity.at(n, 0), f = -pressure_[k] * out * this->area_[k];
+      push(u.phases[1], n, a, nI * f, u.dt);
+      push(u.phases[0], n, a, (1 - nI) * f, u.dt);
+    }
+    this->record(u);
+  }
+  void constrain_grid_update(const GridUpdate& u) const override { this->release(u); }
+  void before_constrain(const NodalVector& v, int) override { this->record(v); }
+  void constrain(const NodalVector& v) const override { this->release(v); }
+
+ private:
+  static void push(const PhaseUpdate& ph, size_t n, int a, double f, double dt) {
+    const double m = ph.mass.at(n, 0);
+    if (!(m > 0)) return;
+    ph.acceleration.at(n, a) += f / m;
+    ph.velocity.at(n, a) += dt * f / m;
+  }
+  std::vector<double> pressure_;  // per face node (Pa)
+};
+
+LOAM_REGISTER(Boundary, PrescribedPorePressure)
+
+}  // namespace loam

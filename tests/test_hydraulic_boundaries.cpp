@@ -1,0 +1,188 @@
+// Hydraulic face conditions of the two-phase scheme (plugins/drained.cpp, impermeable.cpp,
+// prescribed_pore_pressure.cpp; framework/hydraulic_face.hpp) on the seed-001 Terzaghi column
+// (configs/seed001_terzaghi.yaml: 1 m, c_v = 1.0194 m^2/s, p0 = 10 kPa, free drained top, fixed
+// base), and the `phase` option of fixed/slip. References: Terzaghi's series (VERIFICATION.md C,
+// plugins/terzaghi.hpp) and equilibrium.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "plugins/terzaghi.hpp"
+
+namespace {
+
+const double kCv = 1.0194, kP0 = 1e4;
+
+struct Sample {
+  double t, x, p, sxx;
+};
+
+/// The Terzaghi column with `boundaries` replacing its own and a probe at the particle nearest
+/// `probe_x` (position, pore pressure, stress); returns the probe's time series.
+std::vector<Sample> run_column(const std::string& boundaries, double probe_x, double end) {
+  loam_test::TempDir dir("hydraulic");
+  std::filesystem::create_directories(dir.path);
+  std::ifstream in(std::string(LOAM_SOURCE_DIR) + "/configs/seed001_terzaghi.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string cfg = text.str();
+  const std::string own = "boundaries:\n  - {type: fixed, face: x-}\n";
+  REQUIRE(cfg.find(own) != std::string::npos);
+  cfg.replace(cfg.find(own), own.size(), "boundaries:\n" + boundaries);
+  cfg += "probes:\n  - {name: p, particle_near: [" + std::to_string(probe_x) +
+         "], fields: [position, pore_pressure, stress]}\n";
+  std::ofstream(dir.path / "column.yaml") << cfg;
+  auto r = loam_test::run_loam("run " + (dir.path / "column.yaml").string() +
+                               " --quiet --threads 1 --out " + (dir.path / "out").string() +
+                               " --set time.end=" + std::to_string(end) +
+                               " --set output.every_time=" + std::to_string(end));
+  if (r.exit_code != 0) FAIL("loam run failed:\n" << r.output);
+  std::vector<Sample> s;
+  std::ifstream csv(dir.path / "out" / "probe_p.csv");
+  std::string line;
+  std::getline(csv, line);  // step,time,position,pore_pressure,stress_xx,...
+  while (std::getline(csv, line)) {
+    std::stringstream ls(line);
+    std::string cell;
+    std::vector<double> v;
+    while (std::getline(ls, cell, ',')) v.push_back(std::stod(cell));
+    s.push_back({v[1], v[2], v[3], v[4]});
+  }
+  return s;
+}
+
+const Sample& at(const std::vector<Sample>& s, double t) {
+  size_t best = 0;
+  for (size_t i = 0; i < s.size(); ++i)
+    if (std::fabs(s[i].t - t) < std::fabs(s[best].t - t)) best = i;
+  return s[best];
+}
+
+double mean_p(const std::vector<Sample>& s, double t0, double t1) {
+  double sum = 0;
+  int n = 0;
+  for (const auto& x : s)
+    if (x.t >= t0 && x.t <= t1) sum += x.p, ++n;
+  return sum / n;
+}
+
+}  // namespace
+
+TEST_CASE("hydraulic: fixed + drained base drains both ways (Terzaghi with H/2)",
+          "[two_phase][hydraulic][verification]") {
+  // Reference: two-way drainage of a 1 m column = the one-way series on a 0.5 m drainage
+  // length, T' = c_v t / 0.5^2, the mid-plane being the impermeable symmetry plane. Probes at
+  // the mid particle and at the particles next to the base and the top. Target as the Terzaghi
+  // column: |p/p0 - exact| <= 0.02 at the mid particle at T' = 0.2, 0.5, 1 (earlier the
+  // undrained wave still rings: the open base does not reflect it like the fixed one), and
+  // base and top particles within 0.02 p0 of each other (symmetry).
+  const std::string b = "  - {type: fixed, face: x-}\n  - {type: drained, face: x-}\n";
+  const double end = 1.0 * 0.25 / kCv + 1e-3;
+  auto mid = run_column(b, 0.5, end), base = run_column(b, 0.0, end), top = run_column(b, 1.0, end);
+  for (double T : {0.2, 0.5, 1.0}) {
+    const double t = T * 0.25 / kCv;
+    const Sample& m = at(mid, t);
+    const double zeta = 1 - std::fabs(m.x - 0.5) / 0.5;  // from the nearer drained face
+    const double exact = loam::terzaghi_pressure(zeta, kCv * m.t / 0.25);
+    const double e = std::fabs(m.p / kP0 - exact);
+    const double asym = std::fabs(at(base, t).p - at(top, t).p) / kP0;
+    std::printf(
+        "two-way drainage T' = %.1f: mid p/p0 = %.4f, exact %.4f, error %.4f; "
+        "|p_base - p_top|/p0 = %.4f\n",
+        T, m.p / kP0, exact, e, asym);
+    CHECK(e <= 0.02);
+    CHECK(asym <= 0.02);
+  }
+}
+
+TEST_CASE("hydraulic: an impermeable top keeps the column undrained",
+          "[two_phase][hydraulic][verification]") {
+  // With the top sealed (w_n = v_n) no water can leave: the base pressure must average
+  // Skempton's B p0 = 0.9982 p0 (within 5 %; it rings undamped about it) over 0.4 - 0.5 s,
+  // when the free-top column has drained the base to 0.37 p0 (Terzaghi, T = 0.51; bound 0.5).
+  const double end = 0.5;
+  auto sealed =
+      run_column("  - {type: fixed, face: x-}\n  - {type: impermeable, face: x+}\n", 0.0, end);
+  auto open = run_column("  - {type: fixed, face: x-}\n", 0.0, end);
+  const double ps = mean_p(sealed, 0.4, 0.5) / kP0, po = mean_p(open, 0.4, 0.5) / kP0;
+  std::printf("impermeable top: base p/p0 averaged over 0.4-0.5 s %.4f (free top %.4f)\n", ps, po);
+  CHECK(ps == Approx(0.9982).epsilon(0.05));
+  CHECK(po < 0.5);
+}
+
+TEST_CASE("hydraulic: prescribed pore pressure at the base drives steady upward seepage",
+          "[two_phase][hydraulic][verification]") {
+  // p = 5 kPa held on the fixed base (its cell stays full of soil) and p = 0 at the free top:
+  // steady seepage with the linear profile p = 5000 (1 - z / H); the total stress stays the
+  // load, -10 kPa, so sigma'_xx = -10000 + p. After T = 2.5 (transient < 1e-2 of its start)
+  // the base and mid particles must show p and sigma'_xx within 2 % of that. The head form,
+  // head = 5000 / 9810 m at the base (z = 0), must give the same run to 1e-6.
+  const double end = 2.5 / kCv;
+  const std::string fixed = "  - {type: fixed, face: x-}\n";
+  for (double x : {0.0, 0.5}) {
+    auto pr = run_column(fixed + "  - {type: prescribed_pore_pressure, face: x-, pressure: 5000}\n",
+                         x, end);
+    auto hd = run_column(fixed + "  - {type: prescribed_pore_pressure, face: x-, head: " +
+                             std::to_string(5000.0 / 9810.0) + "}\n",
+                         x, end);
+    const Sample &a = pr.back(), &b = hd.back();
+    const double p_exact = 5000 * (1 - a.x);
+    std::printf(
+        "prescribed base pore pressure 5 kPa, particle at z = %.4f: p = %.1f Pa (exact "
+        "%.1f), sigma'_xx = %.1f Pa (exact %.1f); head form %.1f Pa, %.1f Pa\n",
+        a.x, a.p, p_exact, a.sxx, -1e4 + p_exact, b.p, b.sxx);
+    CHECK(a.p == Approx(p_exact).epsilon(0.02));
+    CHECK(a.sxx == Approx(-1e4 + p_exact).epsilon(0.02));
+    CHECK(b.p == Approx(a.p).epsilon(1e-6));
+    CHECK(b.sxx == Approx(a.sxx).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("hydraulic: conflicting or misplaced conditions are located errors",
+          "[two_phase][hydraulic][cli]") {
+  // Reference: README's error contract: FILE:LINE:COL: error: key.path: message, all at once,
+  // exit 2, nothing written.
+  loam_test::TempDir dir("hydraulic_bad");
+  std::filesystem::create_directories(dir.path);
+  const auto cfg = dir.path / "run.yaml";
+  const std::string column =
+      "grid: {origin: [0], extent: [1.0], cell_size: 0.1}\n"
+      "bodies:\n"
+      "  - name: column\n"
+      "    generator: {type: box, min: [0], max: [1.0]}\n"
+      "    material: {type: linear_elastic, E: 1.0e7, nu: 0.0, density: 2650}\n"
+      "time: {end: 0.01}\n";
+  // Two-phase: drained and impermeable on the same face.
+  std::ofstream(cfg) << column
+                     << "scheme: {type: two_phase_single_point, porosity: 0.4, drag: {type: "
+                        "darcy, hydraulic_conductivity: 1.0e-3}}\n"
+                        "boundaries:\n"
+                        "  - {type: drained, face: x+}\n"
+                        "  - {type: impermeable, face: x+}\n";
+  auto r =
+      loam_test::run_loam("run " + cfg.string() + " --quiet --out " + (dir.path / "out").string());
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find(cfg.string() + ":10:") != std::string::npos);
+  CHECK(r.output.find("error: boundaries.1.face: face x+ already has the hydraulic condition "
+                      "'drained' (boundaries.0)") != std::string::npos);
+  // Single phase: a hydraulic condition and a water-only fixity, both reported.
+  std::ofstream(cfg) << column
+                     << "boundaries:\n"
+                        "  - {type: drained, face: x+}\n"
+                        "  - {type: fixed, face: x-, phase: water}\n";
+  r = loam_test::run_loam("run " + cfg.string() + " --quiet --out " + (dir.path / "out").string());
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("error: boundaries.0: 'drained' is a hydraulic condition on the pore "
+                      "water: it needs a two-phase scheme") != std::string::npos);
+  CHECK(r.output.find("error: boundaries.1.phase: phase: water needs a two-phase scheme") !=
+        std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir.path / "out"));
+}
