@@ -200,6 +200,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   // Pore-pressure increments of the step and, per grid cell, the volume-weighted sum of the
   // updated pressures and the volume (pressure_smoothing: cell).
   std::vector<double> dp_, cell_;
+  std::vector<size_t> cell_index_;  // each particle's cell, from the first pass
   bool smooth_ = true;
   struct alignas(64) Scratch {
     StencilBlock<D> stencil;
@@ -238,9 +239,11 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     std::fill(cell_.begin(), cell_.end(), 0.0);
     // A particle's cell lies inside its node stencil, so the race-free colouring of the
     // scatter covers the cell sums too.
+    cell_index_.resize(P.size());
     sim.scatter_blocks([&](size_t b, int count, int) {
       for (size_t i = b; i < b + size_t(count); ++i) {
         const size_t c = cell_of(i);
+        cell_index_[i] = c;
         const double V = P.col(P.volume)[i];
         cell_[2 * c] += V * (p[i] + dp_[i]);
         cell_[2 * c + 1] += V;
@@ -248,7 +251,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     });
 #pragma omp parallel for schedule(static) num_threads(sim.threads)
     for (long i = 0; i < np; ++i) {
-      const size_t c = cell_of(size_t(i));
+      const size_t c = cell_index_[size_t(i)];
       p[i] = cell_[2 * c] / cell_[2 * c + 1];
     }
   }
