@@ -44,6 +44,19 @@ Schema config_schema() {
     b.plugin("velocity", "field", "initial velocity (a list is a constant)").components(kDimension);
     b.plugin("stress", "field", "initial Cauchy stress, Voigt xx yy zz xy yz xz (tension positive)")
         .components(-100);  // resolved to the stress component count below
+    {
+      Schema i;
+      i.text("field",
+             "a scalar particle field the run has after set-up (e.g. pore_pressure of a "
+             "two-phase scheme)")
+          .required();
+      i.plugin("value", "field", "its initial value (a list is a constant)")
+          .components(1)
+          .required();
+      b.section_list("initial", i,
+                     "initial values of further scalar particle fields, set after the scheme "
+                     "and materials have created them (e.g. a hydrostatic pore pressure)");
+    }
     s.section_list("bodies", b, "bodies of particles").required();
   }
   {

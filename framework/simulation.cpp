@@ -46,6 +46,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   shape->setup(*this, diag);
   scheme->setup(*this, diag);
   for (size_t m = 0; m < materials.size(); ++m) materials[m]->setup(*this, int(m), diag);
+  if (particles_ok) initialize_fields(diag);
   bool particle_loads = false;
   for (auto& l : loads) particle_loads = particle_loads || l->uses_particle_forces();
   if (particle_loads)
@@ -239,6 +240,37 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
       }
     }
   }
+}
+
+template <int D>
+void Simulation<D>::initialize_fields(Diagnostics& diag) {
+  // Before the first sort: particle index = id, so a body's particles are its id range.
+  const auto& bl = config.list("bodies");
+  for (size_t b = 0; b < bl.size() && b < bodies.size(); ++b)
+    for (const Params& e : bl[b].list("initial")) {
+      const std::string name = e.text("field");
+      const int h = particles.find(name);
+      // Scalar: one component without component names (1D vectors have one component too).
+      auto scalar = [&](int k) {
+        return particles.info(k).components == 1 && particles.info(k).component_names.empty();
+      };
+      if (h < 0 || !scalar(h)) {
+        std::vector<std::string> scalars;
+        for (int k = 0; k < particles.num_fields(); ++k)
+          if (scalar(k)) scalars.push_back(particles.info(k).name);
+        diag.error(e.where("field"), e.path("field"),
+                   (h < 0 ? "no particle field '" : "'") + name +
+                       (h < 0 ? "'" : "' is not a scalar field") +
+                       " in this run; scalar fields: " + join(scalars, ", "));
+        continue;
+      }
+      auto f = Registry::instance().create<Field, D>(e.section("value"));
+      std::array<double, D> x{};
+      for (size_t i = bodies[b].first_id; i < bodies[b].first_id + bodies[b].count; ++i) {
+        for (int d = 0; d < D; ++d) x[size_t(d)] = particles.col(particles.position, d)[i];
+        f->value(x, particles.col(h) + i);
+      }
+    }
 }
 
 template <int D>

@@ -162,6 +162,7 @@ class Simulation {
  private:
   void build_grid(const Params& g, Diagnostics& diag);
   void generate_bodies(Diagnostics& diag);
+  void initialize_fields(Diagnostics& diag);  // bodies[].initial
   void create_plugins(Diagnostics& diag);
   std::vector<std::pair<std::string, std::pair<Vec, Vec>>> sets_;
   mutable std::vector<uint32_t> index_of_id_;
