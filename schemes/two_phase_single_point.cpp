@@ -10,7 +10,10 @@
 // Per step (lumped masses, explicit in the forces; stress after the grid update):
 //   1. particle -> grid: solid mass and momentum, water mass and momentum, and per node
 //        mixture force  F   = sum [ -V (sigma' - p I) grad N + (m_s + m_w) g N + f_ext N ]
-//        water force    F_w = sum [  V n p grad N + m_w g N ]          (-n grad p, weak form)
+//        water force    F_w = n_I sum [ V p grad N ] + m_w g N        (-n grad p, weak form;
+//                         n_I the nodal porosity. sum [V n p grad N] would be -grad(n p), a
+//                         spurious -p grad n where the porosity varies: it drove the large-
+//                         strain column unstable without pressure smoothing)
 //        drag           Q_I = sum V Q_p N     (Q from the drag plugin, per unit mixture volume:
 //                                              force on the water -Q (w - v))
 //   2. grid: water momentum m_w dw/dt = F_w - Q (w - v) and mixture momentum
@@ -293,7 +296,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         for (int j = 0; j < D; ++j)
           sv[d][j] = V[p] * (P.col(P.stress, voigt_index(d, j))[i] - (d == j ? pw[p] : 0.0));
       }
-      const double vnp = V[p] * n[p] * pw[p], vq = V[p] * sc.Q[size_t(p)];
+      const double vp = V[p] * pw[p], vq = V[p] * sc.Q[size_t(p)];
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
@@ -311,7 +314,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
           double f = w * body[d];
           for (int j = 0; j < D; ++j) f -= sv[d][j] * gr[j];
           r[kF + d] += f;
-          r[kFw + d] += w * body_w[d] + vnp * gr[d];
+          r[kFw + d] += w * body_w[d] + vp * gr[d];
         }
       }
     }
@@ -334,7 +337,11 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       r[kN] = r[kN] > 0 ? mw / (rho_w_ * r[kN]) : 0.0;
       for (int d = 0; d < D; ++d) {
         const double v = r[kV + d] / ms, w = mw > tol ? r[kW + d] / mw : v;
-        const double F = r[kF + d], Fw = r[kFw + d];
+        const double F = r[kF + d];
+        // -n grad p: the nodal porosity times the weak form of -grad p (sum V p grad N),
+        // (not of -grad(n p), which would add a spurious -p grad n where n varies).
+        const double Fw =
+            r[kN] * (r[kFw + d] - mw * sim.gravity[size_t(d)]) + mw * sim.gravity[size_t(d)];
         // [ mw/dt + Q    -Q        ] [w']   [ mw w/dt + Fw     ]
         // [ -Q           ms/dt + Q ] [v'] = [ ms v/dt + F - Fw ]
         const double a11 = mw / dt + Q, a22 = ms / dt + Q;

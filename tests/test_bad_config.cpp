@@ -167,7 +167,7 @@ time:
                   "missing required key 'material' (constitutive model of the body)"),
        s.error_at(7, 5, "bodies.0.materal",
                   "unknown key 'materal'; did you mean 'material'? valid keys are: name, "
-                  "generator, particles_per_cell, material, velocity, stress")});
+                  "generator, particles_per_cell, material, velocity, stress, initial")});
 }
 
 TEST_CASE("a string where a real number is expected", "[bad_config]") {

@@ -64,18 +64,21 @@ TEST_CASE("large strain: gimp with stretched domains also settles to exp(-0.5) w
                0.606531);
 }
 
-TEST_CASE("large strain: without pressure smoothing the column fails (porosity leaves (0, 1))",
+TEST_CASE("large strain: without pressure smoothing the pore pressure checkerboards",
           "[two_phase][large_strain]") {
   // One pore pressure per particle lets a particle-to-particle checkerboard grow once particles
   // cross cells (schemes/two_phase_single_point.cpp, apply_pressure_increment). This documents
-  // why pressure_smoothing: cell is the default: the same run without it must stop, exit 3.
+  // why pressure_smoothing: cell is the default: without it the drained column still carries
+  // pore pressures of the order of the load (measured 2026-12-01: max |p| = 65 q at the end,
+  // against 4e-4 q with smoothing; before the water force became -n grad p the run even
+  // stopped with the porosity out of (0, 1)). Bound: max |p| > q.
   loam_test::TempDir dir("large_strain_none");
-  const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/seed001_large_strain.yaml";
-  auto r = loam_test::run_loam("run " + cfg + " --quiet --threads 1 --out " + dir.path.string() +
-                               kFast + " --set scheme.pressure_smoothing=none");
-  std::printf("%s", r.output.c_str());
-  CHECK(r.exit_code == 3);
-  CHECK(r.output.find("porosity left (0, 1)") != std::string::npos);
+  auto s = loam_test::run_scene("seed001_large_strain.yaml", dir.path,
+                                "--threads 1" + kFast + " --set scheme.pressure_smoothing=none");
+  const double residual = s["verify"]["residual_pore_pressure"].get<double>();
+  std::printf("seed001_large_strain without pressure smoothing: max |p| / q = %.3g at the end\n",
+              residual);
+  CHECK(residual > 1.0);
 }
 
 TEST_CASE("large strain: the paper's configuration (k = 1e-3, 150 s), both formulations",
