@@ -286,13 +286,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       const double mw = n[p] * rho_w_ * V[p];
-      double vs[D], vw[D], body[D], body_w[D], sv[D][D];
+      double vs[D], vw[D], body[D], sv[D][D];
       for (int d = 0; d < D; ++d) {
         vs[d] = P.col(P.velocity, d)[i];
         vw[d] = P.col(w_, d)[i];
         const double fe = sim.external_force >= 0 ? P.col(sim.external_force, d)[i] : 0.0;
         body[d] = (ms[p] + mw) * sim.gravity[size_t(d)] + fe;
-        body_w[d] = mw * sim.gravity[size_t(d)];
         for (int j = 0; j < D; ++j)
           sv[d][j] = V[p] * (P.col(P.stress, voigt_index(d, j))[i] - (d == j ? pw[p] : 0.0));
       }
@@ -314,7 +313,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
           double f = w * body[d];
           for (int j = 0; j < D; ++j) f -= sv[d][j] * gr[j];
           r[kF + d] += f;
-          r[kFw + d] += w * body_w[d] + vp * gr[d];
+          r[kFw + d] += vp * gr[d];  // the water's weight is added per node
         }
       }
     }
@@ -340,8 +339,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         const double F = r[kF + d];
         // -n grad p: the nodal porosity times the weak form of -grad p (sum V p grad N),
         // (not of -grad(n p), which would add a spurious -p grad n where n varies).
-        const double Fw =
-            r[kN] * (r[kFw + d] - mw * sim.gravity[size_t(d)]) + mw * sim.gravity[size_t(d)];
+        const double Fw = r[kN] * r[kFw + d] + mw * sim.gravity[size_t(d)];
         // [ mw/dt + Q    -Q        ] [w']   [ mw w/dt + Fw     ]
         // [ -Q           ms/dt + Q ] [v'] = [ ms v/dt + F - Fw ]
         const double a11 = mw / dt + Q, a22 = ms / dt + Q;
