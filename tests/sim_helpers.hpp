@@ -4,7 +4,11 @@
 #include <stdexcept>
 #include <string>
 
+#include <yaml-cpp/yaml.h>
+#include <catch2/catch.hpp>
+
 #include "framework/config.hpp"
+#include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 
 namespace loam_test {
@@ -33,6 +37,23 @@ void advance(loam::Simulation<D>& sim, int steps) {
     ++sim.step;
     sim.maintain_partition();
   }
+}
+
+/// A reference plugin from its `verify:` YAML text, set up on `sim` (REQUIREs no errors).
+template <int D>
+std::unique_ptr<loam::Reference<D>> make_reference(loam::Simulation<D>& sim,
+                                                   const std::string& yaml) {
+  loam::ValidationContext ctx;
+  ctx.file = "verify.yaml";
+  ctx.dimension = D;
+  loam::Diagnostics diag;
+  loam::Params p = loam::validate_plugin(YAML::Load(yaml), "reference", loam::kDimension, "verify",
+                                         loam::Location{"verify.yaml", 1, 1}, ctx, diag);
+  REQUIRE(diag.ok());
+  auto ref = loam::Registry::instance().create<loam::Reference, D>(p);
+  ref->setup(sim, diag);
+  REQUIRE(diag.ok());
+  return ref;
 }
 
 }  // namespace loam_test

@@ -37,22 +37,6 @@ std::string scene() {
 }
 
 template <int D>
-std::unique_ptr<loam::Reference<D>> make_reference(loam::Simulation<D>& sim,
-                                                   const std::string& yaml) {
-  loam::ValidationContext ctx;
-  ctx.file = "verify.yaml";
-  ctx.dimension = D;
-  loam::Diagnostics diag;
-  loam::Params p = loam::validate_plugin(YAML::Load(yaml), "reference", loam::kDimension, "verify",
-                                         loam::Location{"verify.yaml", 1, 1}, ctx, diag);
-  REQUIRE(diag.ok());
-  auto ref = loam::Registry::instance().create<loam::Reference, D>(p);
-  ref->setup(sim, diag);
-  REQUIRE(diag.ok());
-  return ref;
-}
-
-template <int D>
 void check_settlement() {
   // Hand values: every column particle's volume times 0.9 -> height 0.9 m, settlement 0.1 m;
   // expected 0.08 -> error +0.25; paper 0.125 -> -0.2. Vertical effective stress -2e4 and -4e4
@@ -62,9 +46,9 @@ void check_settlement() {
   auto sim = loam_test::make_simulation<D>(scene<D>());
   auto& P = sim->particles;
   const int pore = P.request({"pore_pressure", 1, "Pa", "excess pore pressure", {}});
-  auto ref = make_reference<D>(*sim,
-                               "{type: settlement, body: column, load: 1.0e4, "
-                               "expected_settlement: 0.08, paper_settlement: 0.125}");
+  auto ref = loam_test::make_reference<D>(*sim,
+                                          "{type: settlement, body: column, load: 1.0e4, "
+                                          "expected_settlement: 0.08, paper_settlement: 0.125}");
   constexpr int NS = loam::Particles<D>::NS;
   size_t k = 0;
   for (size_t i = 0; i < P.size(); ++i) {
@@ -115,7 +99,7 @@ TEST_CASE("settlement reference: height, settlement, stress and residual by hand
 TEST_CASE("settlement reference: without expected or paper values those metrics are absent",
           "[reference][unit]") {
   auto sim = loam_test::make_simulation<1>(scene<1>());
-  auto ref = make_reference<1>(*sim, "{type: settlement, load: 1.0e4}");
+  auto ref = loam_test::make_reference<1>(*sim, "{type: settlement, load: 1.0e4}");
   auto m = ref->metrics(*sim);
   // The default body is the first one (the cap, 0.2 m), untouched: no settlement; single phase:
   // no pore pressure.

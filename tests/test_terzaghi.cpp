@@ -153,22 +153,6 @@ std::string column_scene() {
          "time: {end: 1}\n";
 }
 
-template <int D>
-std::unique_ptr<loam::Reference<D>> make_terzaghi(loam::Simulation<D>& sim,
-                                                  const std::string& yaml) {
-  loam::ValidationContext ctx;
-  ctx.file = "verify.yaml";
-  ctx.dimension = D;
-  loam::Diagnostics diag;
-  loam::Params p = loam::validate_plugin(YAML::Load(yaml), "reference", loam::kDimension, "verify",
-                                         loam::Location{"verify.yaml", 1, 1}, ctx, diag);
-  REQUIRE(diag.ok());
-  auto ref = loam::Registry::instance().create<loam::Reference, D>(p);
-  ref->setup(sim, diag);
-  REQUIRE(diag.ok());
-  return ref;
-}
-
 /// Fill pore_pressure with p0 * exact(zeta0, T), zeta0 = 1 - z0 (initial positions, H = 1), then
 /// compress the column uniformly by `strain` (z -> (1 - strain) z) so that the current-geometry
 /// zeta of each particle equals its initial one.
@@ -196,9 +180,10 @@ void check_reference_sampling() {
   const int pore = P.request({"pore_pressure", 1, "Pa", "excess pore pressure", {}});
   std::vector<double> z0(P.size());
   for (size_t i = 0; i < P.size(); ++i) z0[P.id[i]] = P.col(P.position, D - 1)[i];
-  auto ref = make_terzaghi<D>(*sim,
-                              "{type: terzaghi, load: 1.0e4, consolidation_coefficient: 0.01, "
-                              "time_factors: [0.1, 0.5, 1]}");
+  auto ref =
+      loam_test::make_reference<D>(*sim,
+                                   "{type: terzaghi, load: 1.0e4, consolidation_coefficient: 0.01, "
+                                   "time_factors: [0.1, 0.5, 1]}");
   const double cv = 0.01, p0 = 1e4;
   // Steps before T = 0.1 sample nothing.
   sim->time = 0.05 / cv;

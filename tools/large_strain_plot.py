@@ -7,21 +7,12 @@ Height = sum of particle volumes / initial cross-section (the `volume` output fi
 Usage: large_strain_plot.py --run jaumann DIR --run hencky DIR --cv 0.0102 --p0 5e4 --out x.png
 """
 import argparse
-import math
+import os
 import re
+import sys
 
-
-def terzaghi(zr, T):
-    """p/p0 at relative depth zr (0 at the drained top) and time factor T (small strain)."""
-    if T <= 0:
-        return 1.0
-    s = 0.0
-    for m in range(2000):
-        M = (2 * m + 1) * math.pi / 2
-        s += 2 / M * math.sin(M * zr) * math.exp(-M * M * T)
-        if M * M * T > 50:
-            break
-    return s
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from terzaghi_plot import terzaghi  # noqa: E402  (small-strain series, p/p0 at zeta and T)
 
 
 def frames(run_dir):
