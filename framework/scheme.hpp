@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "params.hpp"
+
 namespace loam {
 
 template <int D>
@@ -36,5 +38,13 @@ class Scheme {
   /// Nodal fields for optional grid output.
   virtual std::vector<GridFieldView> grid_fields() const { return {}; }
 };
+
+/// The `flip` parameter shared by the schemes: FLIP fraction of the particle velocity update.
+inline void add_flip_param(Schema& s) {
+  s.real("flip", "-", "FLIP fraction of the particle velocity update (1: FLIP, 0: PIC)")
+      .def("1")
+      .min(0)
+      .max(1);
+}
 
 }  // namespace loam

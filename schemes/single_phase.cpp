@@ -27,10 +27,7 @@ class SinglePhase : public Scheme<D> {
              "when stress is updated: musl (after re-mapping particle momentum), usl (after the "
              "grid update), usf (before forces)")
         .def("musl");
-    s.real("flip", "-", "FLIP fraction of the particle velocity update (1: FLIP, 0: PIC)")
-        .def("1")
-        .min(0)
-        .max(1);
+    add_flip_param(s);
     return s;
   }
   explicit SinglePhase(const Params& p) : update_(p.text("update")), flip_(p.real("flip")) {}

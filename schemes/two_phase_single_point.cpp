@@ -83,10 +83,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
              "particle-to-particle pressure checkerboard that appears once particles cross "
              "cells); none: every particle keeps its own pressure")
         .def("cell");
-    s.real("flip", "-", "FLIP fraction of the particle velocity update (1: FLIP, 0: PIC)")
-        .def("1")
-        .min(0)
-        .max(1);
+    add_flip_param(s);
     return s;
   }
   explicit TwoPhaseSinglePoint(const Params& p)
