@@ -23,7 +23,8 @@ std::string bench_scene(const std::string& scene, const std::string& shape,
   const std::string base = two_phase ? scene.substr(10) : scene;
   const std::string scheme =
       two_phase ? "{type: two_phase_single_point, porosity: 0.4, water_bulk_modulus: 2.2e9, "
-                  "drag: {type: darcy, hydraulic_conductivity: 1.0e-4}}"
+                  "drag: {type: darcy, hydraulic_conductivity: 1.0e-4}, update: " +
+                      update + "}"
                 : "{type: single_phase, update: " + update + "}";
   // The bench stops after --steps: `end` is only a far horizon, so lift the step budget
   // (time.max_steps) that would refuse a stiff scene's 1000 s.

@@ -22,3 +22,18 @@ TEST_CASE("loam bench runs every fixed scene", "[cli][bench]") {
     ++rows;
   CHECK(rows == 4);
 }
+
+TEST_CASE("loam bench passes --update to the two-phase scenes", "[cli][bench]") {
+  // The two-phase scheme has musl and usl: the row must run and say the order it used; usf,
+  // which it does not have, is the scheme's located error.
+  auto r = loam_test::run_loam(
+      "bench --scenes two_phase_elastic_block_2d --threads 1 --steps 2 --repeat 1 --update usl");
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 0);
+  CHECK(r.output.find("two_phase_elastic_block_2d 2D linear   usl ") != std::string::npos);
+  r = loam_test::run_loam(
+      "bench --scenes two_phase_elastic_block_2d --threads 1 --steps 2 --repeat 1 --update usf");
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("error: scheme.update: unknown value 'usf'") != std::string::npos);
+}
