@@ -8,17 +8,10 @@ Usage: large_strain_plot.py --run jaumann DIR --run hencky DIR --cv 0.0102 --p0 
 """
 import argparse
 import os
-import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from terzaghi_plot import terzaghi  # noqa: E402  (small-strain series, p/p0 at zeta and T)
-
-
-def frames(run_dir):
-    xdmf = open(run_dir + "/particles.xdmf").read()
-    found = re.findall(r'<Time Value="([^"]+)"/>.*?(particles_\d+\w*\.h5):/position', xdmf, re.S)
-    return [(float(t), run_dir + "/" + f) for t, f in found]
+from terzaghi_plot import frames, terzaghi  # noqa: E402  (small-strain series, p/p0 at zeta and T)
 
 
 def main():

@@ -13,17 +13,10 @@ The vertical axis is the last coordinate; depth is measured from each frame's cu
 import argparse
 import csv
 import os
-import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from terzaghi_plot import terzaghi  # noqa: E402
-
-
-def frames(run_dir):
-    xdmf = open(run_dir + "/particles.xdmf").read()
-    found = re.findall(r'<Time Value="([^"]+)"/>.*?(particles_\d+\w*\.h5):/position', xdmf, re.S)
-    return [(float(t), f) for t, f in found]
+from terzaghi_plot import frames, terzaghi  # noqa: E402
 
 
 def profiles(ax, run_dir, times, a, title):
@@ -31,7 +24,7 @@ def profiles(ax, run_dir, times, a, title):
     import matplotlib.pyplot as plt
 
     fr = frames(run_dir)
-    with h5py.File(run_dir + "/" + fr[0][1]) as f0:
+    with h5py.File(fr[0][1]) as f0:
         pos0 = f0["position"][:]
     axis = max(d for d in range(pos0.shape[1]) if abs(pos0[:, d]).max() > 0)
     z0 = sorted(set(pos0[:, axis]))
@@ -39,7 +32,7 @@ def profiles(ax, run_dir, times, a, title):
     colors = plt.cm.viridis([i / max(1, len(times) - 1) for i in range(len(times))])
     for t_want, c in zip(times, colors):
         t, name = min(fr, key=lambda f: abs(f[0] - t_want))
-        with h5py.File(run_dir + "/" + name) as f:
+        with h5py.File(name) as f:
             z = f["position"][:, axis]
             p = f["pore_pressure"][:]
         depth = z.max() + half - z

@@ -23,6 +23,13 @@ def terzaghi(zr, T):
     return s
 
 
+def frames(run_dir):
+    """(time, path) of every particle frame of a run, from its ParaView index particles.xdmf."""
+    xdmf = open(run_dir + "/particles.xdmf").read()
+    found = re.findall(r'<Time Value="([^"]+)"/>.*?(particles_\d+\w*\.h5):/position', xdmf, re.S)
+    return [(float(t), run_dir + "/" + f) for t, f in found]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("run_dir")
@@ -39,15 +46,13 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    xdmf = open(a.run_dir + "/particles.xdmf").read()
-    frames = re.findall(r'<Time Value="([^"]+)"/>.*?(particles_\d+\w*\.h5):/position', xdmf, re.S)
-    frames = [(float(t), f) for t, f in frames]
+    fr = frames(a.run_dir)
     fig, ax = plt.subplots(figsize=(5.5, 5))
     colors = plt.cm.viridis([i / max(1, len(a.T) - 1) for i in range(len(a.T))])
     for T, c in zip(a.T, colors):
         t_want = T * a.H ** 2 / a.cv
-        t, name = min(frames, key=lambda f: abs(f[0] - t_want))
-        with h5py.File(a.run_dir + "/" + name) as f:
+        t, name = min(fr, key=lambda f: abs(f[0] - t_want))
+        with h5py.File(name) as f:
             pos = f["position"][:]
             p = f["pore_pressure"][:]
         # the vertical axis is the last non-trivial coordinate (y in 2D, x in 1D)
@@ -55,7 +60,7 @@ def main():
         if abs(pos[:, 2]).max() > 0:
             axis = 2
         z = pos[:, axis]
-        with h5py.File(a.run_dir + "/" + frames[0][1]) as f0:
+        with h5py.File(fr[0][1]) as f0:
             z0 = sorted(set(f0["position"][:, axis]))
             top = z0[-1] + 0.5 * (z0[1] - z0[0])  # particle domains: half a spacing above
         depth = top - z
