@@ -15,7 +15,7 @@
 #include <limits>
 
 #include "framework/registry.hpp"
-#include "framework/simulation.hpp"
+#include "plugins/column.hpp"
 
 namespace loam {
 
@@ -44,28 +44,16 @@ class ConsolidatedHeight : public Reference<D> {
         ratio_(p.real("load") / p.real("constrained_modulus")),
         hencky_(p.text("formulation") == "hencky") {}
 
-  void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    body_ = sim.body_param(params_, "body", diag);
-    if (body_ < 0) return;
-    const Body& b = sim.bodies[size_t(body_)];
-    H0_ = b.upper[D - 1] - b.lower[D - 1];
-    V0_ = volume(sim);
-    pore_ = sim.particles.find("pore_pressure");
-  }
+  void setup(Simulation<D>& sim, Diagnostics& diag) override { col_.setup(sim, params_, diag); }
 
   std::map<std::string, double> metrics(Simulation<D>& sim) override {
     std::map<std::string, double> m;
-    const double h = volume(sim) / (V0_ / H0_), exact = H0_ * stretch();
+    const double h = col_.height(sim), exact = col_.H0 * stretch();
     m["final_height"] = h;
     m["exact_height"] = exact;
     m["height_error"] = (h - exact) / exact;
-    if (pore_ >= 0) {
-      const auto& P = sim.particles;
-      double worst = 0;
-      for (size_t i = 0; i < P.size(); ++i)
-        if (P.body[i] == body_) worst = std::max(worst, std::fabs(P.col(pore_)[i]));
-      m["residual_pore_pressure"] = worst / params_.real("load");
-    }
+    if (col_.pore >= 0)
+      m["residual_pore_pressure"] = col_.max_pore_pressure(sim) / params_.real("load");
     if (params_.has("paper_height")) {
       m["paper_height"] = params_.real("paper_height");
       m["height_vs_paper"] = (h - m["paper_height"]) / m["paper_height"];
@@ -86,19 +74,10 @@ class ConsolidatedHeight : public Reference<D> {
     }
     return J;
   }
-  double volume(const Simulation<D>& sim) const {
-    const auto& P = sim.particles;
-    double v = 0;
-    for (size_t i = 0; i < P.size(); ++i)
-      if (P.body[i] == body_) v += P.col(P.volume)[i];
-    return v;
-  }
-
   Params params_;
   double ratio_;
   bool hencky_;
-  int body_ = 0, pore_ = -1;
-  double H0_ = 1, V0_ = 1;
+  Column<D> col_;
 };
 
 LOAM_REGISTER(Reference, ConsolidatedHeight)

@@ -19,7 +19,7 @@
 #include <cmath>
 
 #include "framework/registry.hpp"
-#include "framework/simulation.hpp"
+#include "plugins/column.hpp"
 
 namespace loam {
 
@@ -47,31 +47,20 @@ class Settlement : public Reference<D> {
   }
   explicit Settlement(const Params& p) : params_(p) {}
 
-  void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    body_ = sim.body_param(params_, "body", diag);
-    if (body_ < 0) return;
-    const Body& b = sim.bodies[size_t(body_)];
-    H0_ = b.upper[D - 1] - b.lower[D - 1];
-    V0_ = sum(sim, [&](size_t i) { return sim.particles.col(sim.particles.volume)[i]; });
-    pore_ = sim.particles.find("pore_pressure");
-  }
+  void setup(Simulation<D>& sim, Diagnostics& diag) override { col_.setup(sim, params_, diag); }
 
   std::map<std::string, double> metrics(Simulation<D>& sim) override {
     const auto& P = sim.particles;
     const double* V = P.col(P.volume);
     const double* sv = P.col(P.stress, D - 1);  // normal stress along the last axis
     std::map<std::string, double> m;
-    const double vol = sum(sim, [&](size_t i) { return V[i]; });
-    const double h = vol / (V0_ / H0_), s = H0_ - h;
+    const double vol = col_.sum(sim, [&](size_t i) { return V[i]; });
+    const double h = col_.height(sim), s = col_.H0 - h;
     m["final_height"] = h;
     m["final_settlement"] = s;
-    m["vertical_stress"] = -sum(sim, [&](size_t i) { return V[i] * sv[i]; }) / vol;
-    if (pore_ >= 0) {
-      double worst = 0;
-      for (size_t i = 0; i < P.size(); ++i)
-        if (P.body[i] == body_) worst = std::max(worst, std::fabs(P.col(pore_)[i]));
-      m["residual_pore_pressure"] = worst / params_.real("load");
-    }
+    m["vertical_stress"] = -col_.sum(sim, [&](size_t i) { return V[i] * sv[i]; }) / vol;
+    if (col_.pore >= 0)
+      m["residual_pore_pressure"] = col_.max_pore_pressure(sim) / params_.real("load");
     if (params_.has("expected_settlement")) {
       m["expected_settlement"] = params_.real("expected_settlement");
       m["settlement_error"] = (s - m["expected_settlement"]) / m["expected_settlement"];
@@ -84,18 +73,8 @@ class Settlement : public Reference<D> {
   }
 
  private:
-  template <class F>
-  double sum(const Simulation<D>& sim, F&& value) const {
-    const auto& P = sim.particles;
-    double total = 0;
-    for (size_t i = 0; i < P.size(); ++i)
-      if (P.body[i] == body_) total += value(i);
-    return total;
-  }
-
   Params params_;
-  int body_ = 0, pore_ = -1;
-  double H0_ = 1, V0_ = 1;
+  Column<D> col_;
 };
 
 LOAM_REGISTER(Reference, Settlement)
