@@ -34,12 +34,24 @@ struct GridUpdate {
   NodalVector porosity{nullptr, 0, 0};
 };
 
+/// The nodal forces of a grid step before the scheme integrates them. mixture: the force of the
+/// scheme's only phase, or the mixture (total) force of a two-phase scheme; water, when count ==
+/// 2: the pore water's force (its momentum equation), with the nodal porosity. Conditions that
+/// act by a force rather than a constraint (a prescribed pore pressure on a face) add it here, so
+/// the scheme integrates it with the rest (implicitly in the drag of a two-phase scheme).
+struct GridForces {
+  NodalVector mixture{nullptr, 0, 0}, water{nullptr, 0, 0}, porosity{nullptr, 0, 0};
+  int count = 1;
+};
+
 template <int D>
 class Boundary {
  public:
   static constexpr const char* kind = "boundary";
   virtual ~Boundary() = default;
   virtual void setup(Simulation<D>&, Diagnostics&) {}
+  /// Add face forces to the nodal forces of a step, before the grid update (default: none).
+  virtual void add_forces(const GridForces&) const {}
   /// Zero the constrained components of `v` (a velocity, momentum, acceleration or force).
   virtual void constrain(const NodalVector& v) const = 0;
   /// Constrain the velocity v^{n+1} and acceleration a of a grid update together (v^{n+1} =

@@ -8,7 +8,11 @@
 // condition with `phase: both` (the default of fixed and slip) holds the water too, so its face
 // is impermeable; `drained` and `prescribed_pore_pressure` release the water on their face
 // again: they record its unconstrained update before the mechanical conditions run and restore
-// it afterwards, so a fixed, drained base is written simply as fixed + drained.
+// it afterwards, so a fixed, drained base is written simply as fixed + drained. The restored
+// water was solved against the skeleton's free velocity; the scheme then solves it again against
+// the held skeleton (the drag re-solve of a free phase next to a held one, e.g.
+// two_phase_single_point's follow_held_phase), so the released water is not dragged by a
+// skeleton velocity that the face does not allow.
 #include <string>
 #include <vector>
 

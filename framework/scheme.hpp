@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "energies.hpp"
 #include "params.hpp"
 
 namespace loam {
@@ -35,6 +36,10 @@ class Scheme {
   virtual void step(Simulation<D>&, double dt) = 0;
   /// Phases on the grid: 1, or 2 for a scheme with a pore-water phase (boundary phase 1).
   virtual int phases() const { return 1; }
+  /// Add the energies and momentum of what the scheme carries beyond the particles' mass and
+  /// velocity (a second phase, a stored fluid energy) to `e`, so that the total of a run is
+  /// complete (Simulation::energies).
+  virtual void add_energies(const Simulation<D>&, Energies&) const {}
   /// Nodal fields for optional grid output.
   virtual std::vector<GridFieldView> grid_fields() const { return {}; }
 };

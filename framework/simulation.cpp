@@ -327,6 +327,7 @@ Energies Simulation<D>::energies() const {
     const auto& r = partition.material_ranges[mat];
     if (r.end > r.begin) e.strain += materials[mat]->strain_energy(particles, r.begin, r.end);
   }
+  scheme->add_energies(*this, e);
   return e;
 }
 

@@ -14,6 +14,7 @@
 #include "boundary.hpp"
 #include "damping.hpp"
 #include "diagnostics.hpp"
+#include "energies.hpp"
 #include "field.hpp"
 #include "generator.hpp"
 #include "grid.hpp"
@@ -35,11 +36,6 @@ struct Body {
   size_t first_id = 0, count = 0;    // particle ids [first_id, first_id + count)
   std::vector<double> lower, upper;  // bounding box of the particles' domains
   std::vector<double> spacing;       // particle spacing per axis
-};
-
-struct Energies {
-  double kinetic = 0, strain = 0, gravity = 0;
-  std::vector<double> momentum;
 };
 
 template <int D>
@@ -121,6 +117,10 @@ class Simulation {
     batch.particles = &particles;
     materials[particles.material[b]]->update_stress(batch);
   }
+  /// Face forces of the boundary conditions (GridForces), before the grid update.
+  void apply_boundary_forces(const GridForces& f) const {
+    for (const auto& b : boundaries) b->add_forces(f);
+  }
   void apply_grid_loads(const NodalVector& force) {
     for (const auto& l : loads) l->apply_to_grid(*this, force, time);
   }
@@ -144,6 +144,9 @@ class Simulation {
   void sort();
   /// After a step: keep the partition valid and sort periodically.
   void maintain_partition();
+  /// Kinetic, stored and gravity energy and momentum of every particle set and phase: the
+  /// particles' own (mass, velocity), the materials' strain energy, and the scheme's share
+  /// (Scheme::add_energies: e.g. the pore water of a two-phase scheme).
   Energies energies() const;
 
   /// Particle index of an original id (valid until the next sort).

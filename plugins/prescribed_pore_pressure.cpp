@@ -4,9 +4,10 @@
 // the case p = 0) and the face adds the boundary term of the weak forms (seed 001 eqs. 16-17):
 // with n_out the outward normal and A_I the node's tributary face area, the mixture gets the
 // total traction -p n_out A_I, of which the water equation (per unit pore volume, times the
-// nodal porosity n_I) takes -n_I p n_out A_I and the skeleton the rest, -(1 - n_I) p n_out A_I.
-// Both are applied as explicit nodal forces in the grid update (a += f/m, v += dt f/m), before
-// the mechanical conditions, so a skeleton fixed on the face stays fixed.
+// nodal porosity n_I) takes -n_I p n_out A_I. They are nodal forces added before the scheme
+// solves the grid update (Boundary::add_forces), so the implicit drag couples them like every
+// other force; a skeleton fixed on the face then stays fixed, and the released water follows
+// the held skeleton through the drag (framework/hydraulic_face.hpp).
 #include "framework/hydraulic_face.hpp"
 #include "framework/registry.hpp"
 
@@ -46,31 +47,25 @@ class PrescribedPorePressure : public HydraulicFace<D> {
         pressure_[k] =
             p.real("unit_weight") * (p.real("head") - sim.grid.node_coord(this->nodes_[k], D - 1));
   }
-  /// The face forces go in before the mechanical conditions (a fixed skeleton stays fixed);
-  /// then the water's update is recorded, to be released after them.
-  void before_constraints(const GridUpdate& u) override {
-    if (u.count < 2 || !u.porosity.base) return;
+  void add_forces(const GridForces& f) const override {
+    if (f.count < 2 || !f.porosity.base) return;
     const int a = this->face_.axis;
     const double out = this->face_.upper ? 1.0 : -1.0;
     for (size_t k = 0; k < this->nodes_.size(); ++k) {
       const size_t n = this->nodes_[k];
-      const double nI = u.porosity.at(n, 0), f = -pressure_[k] * out * this->area_[k];
-      push(u.phases[1], n, a, nI * f, u.dt);
-      push(u.phases[0], n, a, (1 - nI) * f, u.dt);
+      const double traction = -pressure_[k] * out * this->area_[k];
+      f.mixture.at(n, a) += traction;
+      f.water.at(n, a) += f.porosity.at(n, 0) * traction;
     }
-    this->record(u);
   }
+  /// The water's update on the face is recorded before the mechanical conditions, to be
+  /// released after them.
+  void before_constraints(const GridUpdate& u) override { this->record(u); }
   void constrain_grid_update(const GridUpdate& u) const override { this->release(u); }
   void before_constrain(const NodalVector& v, int) override { this->record(v); }
   void constrain(const NodalVector& v) const override { this->release(v); }
 
  private:
-  static void push(const PhaseUpdate& ph, size_t n, int a, double f, double dt) {
-    const double m = ph.mass.at(n, 0);
-    if (!(m > 0)) return;
-    ph.acceleration.at(n, a) += f / m;
-    ph.velocity.at(n, a) += dt * f / m;
-  }
   std::vector<double> pressure_;  // per face node (Pa)
 };
 

@@ -8,9 +8,12 @@
 // Under large compression that misplaces the load: the top particle's cell then balances the
 // load with the wrong share of the cell, and the surface particle is over- or under-stressed
 // (1D soft column, issue 6: -25 kPa instead of -50 kPa with CPDI). apply_at: surface adds
-// t A_p N_I(x_s) to the nodal forces at the particle's surface point x_s = x_p + (l_p / 2) n,
-// l_p = s F_nn its current length along the outward face normal n (F: the deformation
-// gradient, requested for this), with the multilinear tent functions N_I: the grid basis of
+// t A_p N_I(x_s) to the nodal forces at the particle's surface point, the centre of its loaded
+// face convected with the deformation gradient F (requested for this), as CPDI convects its
+// domains: x_s = x_p + F (s/2) N, N the outward face normal in the reference configuration and
+// s the particle spacing along it. Under simple shear the point moves tangentially by s gamma/2
+// and under a rotation it turns with the particle (not only x_p + (s F_nn/2) N along a fixed
+// axis, which ignores both). The tent functions N_I are the grid basis of
 // linear, GIMP and CPDI, and for B-splines a distribution with the same resultant and moment.
 // It needs a shape function whose stencil covers the particle domain (not `linear`), otherwise
 // the surface node may carry no mass and the load would be lost.
@@ -37,8 +40,10 @@ class Traction : public Load<D> {
     s.real("ramp_time", "s", "linear ramp from 0 to full load").def("0").min(0);
     s.choice("apply_at", {"particle", "surface"},
              "particle: the force acts at the particle centre (particle weights); surface: at "
-             "the particle's current surface point x_p + (s F_nn / 2) n, with the grid tent "
-             "functions (exact load position under large strain; needs gimp, cpdi or bspline2)")
+             "the particle's current surface point x_p + F (s/2) N (the centre of its loaded face "
+             "convected with the deformation gradient F), with the grid tent functions (exact "
+             "load position under large strain, shear and rotation; needs gimp, cpdi or "
+             "bspline2)")
         .def("particle");
     s.check([](const Params& p, Diagnostics& d) {
       if (p.has("body") == p.has("set"))
@@ -102,12 +107,13 @@ class Traction : public Load<D> {
     const int a = face_.axis;
     for (size_t k = 0; k < ids_.size(); ++k) {
       const size_t i = sim.index_of(ids_[k]);
-      // Surface point and its cell: per axis the lower node and the tent weight of the upper.
-      const double half = 0.5 * length_[k] * P.col(F_, a * D + a)[i];
+      // Surface point x_p + F (s/2) N (N = +-e_a, so F N is column a of F) and its cell: per
+      // axis the lower node and the tent weight of the upper.
+      const double half = (face_.upper ? 0.5 : -0.5) * length_[k];
       size_t base = 0;
       std::array<double, D> frac{};
       for (int d = 0; d < D; ++d) {
-        const double x = P.col(P.position, d)[i] + (d == a ? (face_.upper ? half : -half) : 0.0);
+        const double x = P.col(P.position, d)[i] + half * P.col(F_, d * D + a)[i];
         const int c = g.cell_of(x, d);
         frac[size_t(d)] =
             std::clamp((x - g.origin[size_t(d)]) * g.inv_cell[size_t(d)] - c, 0.0, 1.0);

@@ -135,6 +135,9 @@ class SinglePhase : public Scheme<D> {
   /// Nodal forces to updated velocity and acceleration, with loads, damping and constraints.
   void integrate(Simulation<D>& sim, double dt) {
     sim.apply_grid_loads(node_vector(1 + D));
+    GridForces forces;
+    forces.mixture = node_vector(1 + D);
+    sim.apply_boundary_forces(forces);
     sim.apply_damping(
         NodeForces{node_.data(), node_vector(1), node_vector(1 + D), sim.grid.num_nodes, S});
     const long n = long(sim.grid.num_nodes);
