@@ -30,12 +30,21 @@
 // (4^D entries); a longer domain is capped at lp = h (a warning reports how many), and
 // F_dd <= 0 (an inverted domain) stops the run.
 //
-// Grid boundary: nodes outside the grid get a valid node index and zero weight and gradient. A
-// particle whose domain lies inside the grid keeps partition of unity and linear reproduction
-// exactly; if its domain crosses the grid boundary, the part of the domain outside is lost:
-// sum N = 1 - (weight of the missing nodes), e.g. 1 - lp/(4h) for a particle centred on the
-// boundary, and sum grad N != 0. Particles are generated with their domains inside the grid, so
-// this happens only when material reaches the outermost half-domain of the grid.
+// Grid boundary: a domain that crosses the grid boundary would need the ghost node beyond it
+// (node -1 or n+1). As in bspline2.cpp, the ghost is eliminated by extrapolating it linearly
+// from its two inner neighbours, N_0 <- N_0 + 2 N_-1, N_1 <- N_1 - N_-1 (and N_n <- N_n + 2 N_n+1,
+// N_n-1 <- N_n-1 - N_n+1); constants and linear functions take the values 1 = 2*1 - 1 and
+// x_-1 = 2 x_0 - x_1 at the ghost, so partition of unity, sum grad N = 0 and linear reproduction
+// hold at every position in the grid, up to and on its faces, in every axis. With lp <= h/2 the
+// folded weights of a particle at t = (x_p - x_0)/h in [0, 1/2] are the linear hat,
+// S_0 = 1 - t, S_1 = t (node 2 and beyond: 0); e.g. on the face S_0 = 1, so a particle on a
+// held (fixed or slip) face has the face's normal velocity, and near it the normal velocity
+// t v_1 vanishes with the distance t h, so with |v_1| dt < h (CFL) it cannot cross the face. The
+// folded weights stay non-negative in the grid (N_1 >= N_-1 there, also for stretched domains).
+// Dropping the ghost instead (zero weight, as before) left sum N = 1 - lp/(4h) on the face and sum
+// grad N != 0: a particle on a held floor kept the velocity (lp/4h) v_1 of the row above the floor,
+// moved down and left the grid. Stencil entries of ghost nodes carry the nearest valid node index
+// and zero weight and gradient.
 #include <spdlog/spdlog.h>
 
 #include <array>
@@ -160,13 +169,11 @@ class Gimp : public ShapeFunction<D> {
  private:
   bool stretch_;
   bool warned_ = false;
-  // max(v, 0) and clamp(v, 0, 1) (v an integer) in arithmetic: exact, and unlike a select they
-  // are never sunk into branches that stop the loop from vectorising.
+  // max(v, 0) in arithmetic: exact, and unlike a select it is never sunk into a branch that
+  // stops the loop from vectorising (also used for the boundary flags [b == 0] = max(1 - b, 0)
+  // of integer-valued b).
   static double pos(double v) {
     return 0.5 * (v + std::fabs(v));
-  }
-  static double unit(double v) {
-    return pos(v) - pos(v - 1.0);
   }
   int half_width_ = -1, half_width0_ = -1, deformation_gradient_ = -1;
 
@@ -210,13 +217,21 @@ class Gimp : public ShapeFunction<D> {
           const double gs = 0.5 / a * ih, e = pos(a - std::fabs(r)), E = e * e * (0.25 / a);
           const double wp = pos(r) + E, wm = pos(-r) + E;
           const double gp = (pos(r + a) - pos(r - a)) * gs, gm = (pos(-r - a) - pos(a - r)) * gs;
-          const double in_lo = unit(b), in_hi = unit(last - b);  // node b-1, b+1 in the grid
-          ax.w[d][0][p] = in_lo * wm;
-          ax.w[d][1][p] = 1.0 - wp - wm;
-          ax.w[d][2][p] = in_hi * wp;
-          ax.dw[d][0][p] = in_lo * gm;
-          ax.dw[d][1][p] = -(gp + gm);
-          ax.dw[d][2][p] = in_hi * gp;
+          // Fold the ghost node b-1 = -1 (b == 0) or b+1 = n+1 (b == n) into its two inner
+          // neighbours, as in bspline2.cpp: a field known on the grid is extrapolated linearly
+          // to the ghost, u_-1 = 2 u_0 - u_1, so N_0 += 2 N_-1, N_1 -= N_-1 (and mirrored at n).
+          // Constants and linear fields take exactly those ghost values, so partition of unity,
+          // sum dN = 0 and linear reproduction hold up to and on the boundary; at the boundary
+          // node the weights become the linear hat (S_0 = 1 - r, S_1 = r for 0 <= r < 1/2), so
+          // a particle on a held face (r = 0) moves with it. lo = [b == 0], hi = [b == n].
+          const double lo = pos(1.0 - b), hi = pos(b - (last - 1.0));
+          const double wg = lo * wm + hi * wp, gg = lo * gm + hi * gp;  // the ghost's N, dN
+          ax.w[d][0][p] = wm - wg;
+          ax.w[d][1][p] = 1.0 - wp - wm + 2.0 * wg;
+          ax.w[d][2][p] = wp - wg;
+          ax.dw[d][0][p] = gm - gg;
+          ax.dw[d][1][p] = -(gp + gm) + 2.0 * gg;
+          ax.dw[d][2][p] = gp - gg;
         }
       } else {
         for (int p = 0; p < count; ++p) {
@@ -232,11 +247,25 @@ class Gimp : public ShapeFunction<D> {
             const double s = pos(1.0 - std::fabs(u)) + (em * em - 2.0 * e0 * e0 + ep * ep) * inv4a;
             const double ds =
                 (pos(1.0 - std::fabs(u + a)) - pos(1.0 - std::fabs(u - a))) * grad_scale;
-            // 1 for nodes 0 <= i <= n, 0 outside the grid (i is an integer).
-            const double inside = unit(i + 1.0) * unit(last + 1.0 - i);
-            ax.w[d][j][p] = inside * s;
-            ax.dw[d][j][p] = inside * ds;
+            ax.w[d][j][p] = s;
+            ax.dw[d][j][p] = ds;
           }
+          // Only node c-1 = -1 (c == 0) and node c+2 = n+1 (c == n-1) can lie outside the grid
+          // (a domain of lp <= h in cell c reaches no further). Fold each ghost into its two
+          // inner neighbours by linear extrapolation, N_0 += 2 N_-1, N_1 -= N_-1 and
+          // N_n += 2 N_n+1, N_n-1 -= N_n+1, exactly as in the 3-node branch above (both at once
+          // for a one-cell grid). lo = [c == 0], hi = [c == n-1] (i0 = c - 1 is an integer).
+          const double lo = pos(-i0), hi = pos(i0 + 3.0 - last);
+          const double wl = lo * ax.w[d][0][p], wh = hi * ax.w[d][3][p];
+          const double gl = lo * ax.dw[d][0][p], gh = hi * ax.dw[d][3][p];
+          ax.w[d][0][p] -= wl;
+          ax.w[d][1][p] += 2.0 * wl - wh;
+          ax.w[d][2][p] += 2.0 * wh - wl;
+          ax.w[d][3][p] -= wh;
+          ax.dw[d][0][p] -= gl;
+          ax.dw[d][1][p] += 2.0 * gl - gh;
+          ax.dw[d][2][p] += 2.0 * gh - gl;
+          ax.dw[d][3][p] -= gh;
         }
       }
       for (int p = 0; p < count; ++p) {

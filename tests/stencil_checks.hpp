@@ -2,7 +2,8 @@
 // Consistency checks shared by the shape-function tests: evaluate every particle's stencil and
 // measure |sum N - 1|, h |sum grad N|, |sum N x_I - x_p| / h, |sum x_I (x) grad N - I|, and
 // stencil entries outside the node rows [r - rows_below, r + rows_above] the shape function
-// declares for race-free scatter (must be 0).
+// declares for race-free scatter (must be 0), and non-finite weights or gradients (must be 0).
+#include <algorithm>
 #include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -13,12 +14,20 @@
 namespace loam_test {
 
 struct StencilErrors {
-  double sum = 0, grad = 0, repro = 0, grad_repro = 0, rows = 0;
+  double sum = 0, grad = 0, repro = 0, grad_repro = 0, rows = 0, nonfinite = 0;
+
+  /// The worst of both (the counts add up).
+  void merge(const StencilErrors& o) {
+    sum = std::max(sum, o.sum), grad = std::max(grad, o.grad);
+    repro = std::max(repro, o.repro), grad_repro = std::max(grad_repro, o.grad_repro);
+    rows += o.rows, nonfinite += o.nonfinite;
+  }
 };
 
 /// Evaluate every particle (in full blocks) and measure the consistency errors: |sum N - 1|,
 /// h |sum grad N|, |sum N x_I - x_p| / h, |sum x_I (x) grad N - I|, and stencil entries outside
-/// the node rows [r - rows_below, r + rows_above] (must be 0).
+/// the node rows [r - rows_below, r + rows_above] (must be 0), and non-finite weights or gradient
+/// components (must be 0).
 template <int D>
 StencilErrors stencil_consistency(loam::Simulation<D>& sim) {
   auto& P = sim.particles;
@@ -39,6 +48,10 @@ StencilErrors stencil_consistency(loam::Simulation<D>& sim) {
         const int node_row = g.node_ijk(size_t(st.node[kp]))[D - 1];
         if (node_row < row - sim.shape->rows_below() || node_row > row + sim.shape->rows_above())
           e.rows += 1;
+        if (!std::isfinite(st.w[kp])) e.nonfinite += 1;
+        for (int j = 0; j < D; ++j)
+          if (!std::isfinite(st.grad[(size_t(k) * D + size_t(j)) * loam::kBlock + size_t(p)]))
+            e.nonfinite += 1;
         sum += st.w[kp];
         for (int i = 0; i < D; ++i) {
           const double xi = g.node_coord(size_t(st.node[kp]), i);
