@@ -1,8 +1,12 @@
 #pragma once
 // Boundary-condition plugin interface: constrains nodal velocity (and acceleration) components.
-// Schemes call constrain() on every nodal vector that must respect the constraint, and
-// constrain_grid_update() once on the grid update of a step (all phases, with nodal masses).
+// Schemes call Simulation::constrain() on every nodal vector that must respect the constraints,
+// and Simulation::constrain_update() once on the grid update of a step (all phases, with nodal
+// masses), which runs the conditions in passes whatever the order of the config: records
+// (before_constraints), the kinematic pass (constrain_grid_update, marking HeldComponents), the
+// Coulomb pass (coulomb_update) and the hydraulic conditions.
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,6 +27,35 @@ struct PhaseUpdate {
   NodalVector velocity, acceleration, mass;
 };
 
+/// Per grid node, the velocity components of one phase that the mechanical conditions hold in
+/// the current grid update (bit d: component d). A node held by several faces (an edge or a
+/// corner) gets every normal/kinematic constraint first; Coulomb friction then acts only in the
+/// components left free (Bardenhagen et al. 2000), so the result does not depend on the order
+/// the faces are listed in. The Simulation owns one per phase and clears it before each update,
+/// on the nodes marked by the previous one only (face nodes, not the whole grid).
+class HeldComponents {
+ public:
+  void hold(size_t node, int d) {
+    uint8_t& b = bits_[node];
+    if (!b) marked_.push_back(node);
+    b = uint8_t(b | (1u << d));
+  }
+  bool held(size_t node, int d) const { return (bits_[node] >> d) & 1u; }
+  /// Nothing held, on a grid of num_nodes nodes.
+  void clear(size_t num_nodes) {
+    if (bits_.size() != num_nodes) {
+      bits_.assign(num_nodes, 0);
+    } else {
+      for (size_t n : marked_) bits_[n] = 0;
+    }
+    marked_.clear();
+  }
+
+ private:
+  std::vector<uint8_t> bits_;
+  std::vector<size_t> marked_;  // nodes with a bit set
+};
+
 /// The grid update of one step, after the scheme's own implicit terms (e.g. drag). phases[0] is
 /// the scheme's only phase or the solid skeleton; phases[1], when count == 2, is the pore water
 /// of a two-phase scheme (its velocity is the water's own, not relative to the skeleton).
@@ -32,6 +65,9 @@ struct GridUpdate {
   double dt = 0;
   /// Two-phase: the nodal porosity porosity.at(n, 0) (volume-weighted from the particles).
   NodalVector porosity{nullptr, 0, 0};
+  /// The components held per phase, set by Simulation::constrain_update (schemes leave them
+  /// null; a condition driven alone, e.g. by a unit test, must accept null).
+  std::array<HeldComponents*, 2> held{};
 };
 
 /// The nodal forces of a grid step before the scheme integrates them. mixture: the force of the
@@ -52,31 +88,46 @@ class Boundary {
   virtual void setup(Simulation<D>&, Diagnostics&) {}
   /// Add face forces to the nodal forces of a step, before the grid update (default: none).
   virtual void add_forces(const GridForces&) const {}
-  /// Zero the constrained components of `v` (a velocity, momentum, acceleration or force).
+  /// Zero the constrained components of `v` (a velocity, momentum, acceleration or force). On
+  /// the MUSL re-mapped velocities this is the only call (Simulation::constrain): holds only, no
+  /// friction impulse, since the particles already carry the step's impulse from the update.
   virtual void constrain(const NodalVector& v) const = 0;
-  /// Constrain the velocity v^{n+1} and acceleration a of a grid update together (v^{n+1} =
-  /// v^n + dt a). A condition that depends on the motion (Coulomb friction, contact) overrides
-  /// this and keeps a consistent with the velocity it imposes, so FLIP particles see it too.
+  /// Constrain the velocity v^{n+1} and acceleration a of one phase of a grid update together
+  /// (v^{n+1} = v^n + dt a). Default: constrain() both.
   virtual void constrain_update(const NodalVector& v, const NodalVector& a, double /*dt*/) const {
     constrain(v);
     constrain(a);
   }
-  /// The whole grid update of a step: every phase at once, with the nodal masses. A condition
-  /// that applies a force integrated implicitly (a dashpot: v^{n+1} = m v* / (m + dt C) needs m)
-  /// or that couples the phases overrides this. Default: constrain_update of each phase it
-  /// applies to.
+  /// Mark the components constrain() holds at this condition's nodes (fixed: all of them, slip:
+  /// its directions), for the Coulomb pass. Default: none.
+  virtual void mark_held(HeldComponents&) const {}
+  /// Kinematic pass of the grid update: every phase at once, with the nodal masses. A
+  /// condition that applies a force integrated implicitly (a dashpot: v^{n+1} = m v* / (m + dt
+  /// C) needs m), couples the phases or holds a component only under a condition (unilateral
+  /// contact) overrides this, marks what it holds in u.held, and keeps a consistent with the
+  /// velocity it imposes, a += (v_after - v_before) / dt, so FLIP particles see it too. Default:
+  /// constrain_update and mark_held for each phase it applies to.
   virtual void constrain_grid_update(const GridUpdate& u) const {
     for (int k = 0; k < u.count; ++k)
-      if (applies_to(k))
+      if (applies_to(k)) {
         constrain_update(u.phases[size_t(k)].velocity, u.phases[size_t(k)].acceleration, u.dt);
+        if (u.held[size_t(k)]) mark_held(*u.held[size_t(k)]);
+      }
   }
+  /// Coulomb pass, after the kinematic pass of every mechanical condition: a frictional
+  /// condition reduces the velocity in the components no condition holds (u.held), with a
+  /// budget taken from what it recorded before any constraint (before_constraints). Default:
+  /// nothing.
+  virtual void coulomb_update(const GridUpdate&) const {}
   /// Whether constrain() acts on phase k (0: the only phase or the solid, 1: the pore water).
   virtual bool applies_to(int /*phase*/) const { return true; }
   /// Hydraulic conditions (drained, impermeable, prescribed pore pressure) act on the water
-  /// after every mechanical condition, whatever the order of the config, and may first record
-  /// the water's unconstrained state (before_constraints) to release it on a drained face.
+  /// after every mechanical condition, whatever the order of the config.
   virtual bool hydraulic() const { return false; }
+  /// Called on every condition before any condition acts on the grid update: record the unconstrained state the condition needs
+  /// (the water's update to release it on a drained face, a friction face's normal velocity).
   virtual void before_constraints(const GridUpdate&) {}
+  /// The same before the conditions act on a single nodal vector of `phase`.
   virtual void before_constrain(const NodalVector& /*v*/, int /*phase*/) {}
 };
 

@@ -88,23 +88,45 @@ class Simulation {
 
   // --------------------------------------------------------- hooks for schemes
   /// Apply every boundary condition that acts on `phase` (0: the only phase or the solid, 1: the
-  /// pore water) to a nodal vector: mechanical conditions first, then hydraulic ones.
+  /// pore water) to a nodal vector: mechanical conditions first, then hydraulic ones. Here the
+  /// conditions only hold components (zeroing commutes, so the order of the config does not
+  /// matter); friction impulses belong to the grid update.
   void constrain(const NodalVector& v, int phase = 0) const {
-    for (const auto& b : boundaries)
-      if (b->hydraulic() && b->applies_to(phase)) b->before_constrain(v, phase);
+    for (int pass = 0; pass < 2; ++pass)
+      for (const auto& b : boundaries)
+        if (b->hydraulic() == (pass == 0) && b->applies_to(phase)) b->before_constrain(v, phase);
     for (int pass = 0; pass < 2; ++pass)
       for (const auto& b : boundaries)
         if (b->hydraulic() == (pass == 1) && b->applies_to(phase)) b->constrain(v);
   }
   /// Apply every boundary condition to the grid update of a step (velocities, accelerations
-  /// and nodal masses of every phase): mechanical conditions in the order the config lists
-  /// them, then the hydraulic ones.
-  void constrain_update(const GridUpdate& u) const {
-    for (const auto& b : boundaries)
-      if (b->hydraulic()) b->before_constraints(u);
+  /// and nodal masses of every phase), in passes, so that the result does not depend on the
+  /// order of the config at edges and corners where several faces meet:
+  ///  1. before_constraints of every condition (face forces are in already: add_forces),
+  ///     each recording the unconstrained state it needs (a friction face: v_n, whose mu |v_n|
+  ///     is its budget whatever another face does to v_n);
+  ///  2. the kinematic pass of the mechanical conditions (constrain_grid_update): holds,
+  ///     unilateral contact, dashpots; each marks the components it holds per node in held_;
+  ///  3. the Coulomb pass (coulomb_update): friction in the tangential components no condition
+  ///     holds at the node (Bardenhagen et al. 2000: normal constraint, then the Coulomb impulse
+  ///     in the remaining free subspace; several friction faces scale the same free vector, so
+  ///     their order does not matter either);
+  ///  4. the hydraulic conditions on the water.
+  void constrain_update(const GridUpdate& update) const {
+    GridUpdate u = update;
+    for (int k = 0; k < u.count; ++k) {
+      held_[size_t(k)].clear(grid.num_nodes);
+      u.held[size_t(k)] = &held_[size_t(k)];
+    }
     for (int pass = 0; pass < 2; ++pass)
       for (const auto& b : boundaries)
-        if (b->hydraulic() == (pass == 1)) b->constrain_grid_update(u);
+        if (b->hydraulic() == (pass == 0)) b->before_constraints(u);
+    for (const auto& b : boundaries)
+      if (!b->hydraulic()) b->constrain_grid_update(u);
+    for (const auto& b : boundaries)
+      if (!b->hydraulic()) b->coulomb_update(u);
+    for (const auto& b : boundaries)
+      if (b->hydraulic()) b->constrain_grid_update(u);
   }
   /// The material stress update of one block [b, b + count) (one material per block), with
   /// its velocity gradient L in block layout (MaterialBatch).
@@ -169,6 +191,7 @@ class Simulation {
   void create_plugins(Diagnostics& diag);
   std::vector<std::pair<std::string, std::pair<Vec, Vec>>> sets_;
   mutable std::vector<uint32_t> index_of_id_;
+  mutable std::array<HeldComponents, 2> held_;  // per phase, scratch of constrain_update
   mutable bool index_valid_ = false;
   long last_sort_ = 0;
 };

@@ -16,7 +16,11 @@
 //     v^{n+1} = m v* / (m + dt C)
 // per damped component, and the acceleration is kept consistent with it, a += (v^{n+1} - v*)/dt,
 // so that FLIP particle updates see the dashpot too. The face is otherwise free. A dashpot cannot
-// carry a static load: a body pressed onto the face drifts at v = t / (rho c_p).
+// carry a static load: a body pressed onto the face drifts at v = t / (rho c_p). Where it meets
+// other faces it acts in the kinematic pass of Simulation::constrain_update and holds no
+// component (with one phase its scaling commutes with the holds): a friction face sharing a
+// node slides afterwards in the damped free components, its budget mu |v_n| taken before the
+// dashpot.
 //
 // Two-phase schemes (solid and pore water, e.g. two_phase_single_point): the face is an
 // IMPERMEABLE dashpot, as the viscous bottom of seed 002's consolidation column (an impervious

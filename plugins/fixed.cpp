@@ -1,4 +1,5 @@
-// Fixed (no-slip) grid face: every velocity component of the face nodes is zero.
+// Fixed (no-slip) grid face: every velocity component of the face nodes is zero. It holds them
+// all (mark_held), so a friction face sharing an edge or corner has nothing left to slide in.
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 
@@ -25,6 +26,10 @@ class Fixed : public Boundary<D> {
   void constrain(const NodalVector& v) const override {
     for (size_t n : nodes_)
       for (int d = 0; d < D; ++d) v.at(n, d) = 0.0;
+  }
+  void mark_held(HeldComponents& held) const override {
+    for (size_t n : nodes_)
+      for (int d = 0; d < D; ++d) held.hold(n, d);
   }
 
  private:

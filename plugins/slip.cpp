@@ -1,5 +1,6 @@
 // Slip (roller) grid face: the normal velocity component is zero, tangential motion is free.
-// `directions` fixes other components instead (slip per direction).
+// `directions` fixes other components instead (slip per direction). The held components are
+// marked (mark_held): a friction face meeting this one at an edge slides only in the others.
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 
@@ -42,6 +43,10 @@ class Slip : public Boundary<D> {
   void constrain(const NodalVector& v) const override {
     for (size_t n : nodes_)
       for (int d : fixed_) v.at(n, d) = 0.0;
+  }
+  void mark_held(HeldComponents& held) const override {
+    for (size_t n : nodes_)
+      for (int d : fixed_) held.hold(n, d);
   }
 
  private:
