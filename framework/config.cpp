@@ -83,6 +83,13 @@ Schema config_schema() {
               "when it reaches the budget (exit 3)")
         .def("100000000")
         .min(1);
+    t.real("min_dt_ratio", "-",
+           "a stable time step below this fraction of the first step's stops the run (exit 3): "
+           "the wave or particle speed has exploded (e.g. USL with linear shape functions at a "
+           "node of tiny mass), and the run would otherwise crawl until max_steps")
+        .def("1e-6")
+        .above(0)
+        .below(1);
     s.section("time", t, "time integration").required();
   }
   {

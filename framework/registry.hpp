@@ -24,7 +24,8 @@ namespace loam {
 
 /// Bumped when a plugin base interface changes; out-of-tree plugins check it.
 /// 2: Boundary::constrain_grid_update (all phases of a grid update, with nodal masses).
-/// 3: Boundary::mark_held and coulomb_update, GridUpdate::held (the passes of the grid update).
+/// 3: Boundary::mark_held, coulomb_update and add_forces, GridUpdate::held (the passes of the
+///    grid update), Scheme::add_energies.
 constexpr int kPluginAbiVersion = 3;
 
 struct PluginInfo {

@@ -338,8 +338,20 @@ class Run {
     auto t0 = Clock::now(), last_report = t0;
     long steps_at_report = 0;
     const double t_end = sim.end_time;
+    const double min_dt_ratio = cfg_.params.section("time").real("min_dt_ratio");
+    double dt_first = 0;
     while (sim.time < t_end * (1 - 1e-12) && (opt_.max_steps < 0 || sim.step < opt_.max_steps)) {
       double dt = sim.stable_dt();
+      if (dt_first == 0) dt_first = dt;
+      if (dt < min_dt_ratio * dt_first) {
+        failure = "the stable time step collapsed to " + format_number(dt) + " s, below " +
+                  "time.min_dt_ratio = " + format_number(min_dt_ratio) + " of the first step's " +
+                  format_number(dt_first) + " s (largest particle speed " +
+                  format_number(sim.max_speed) +
+                  " m/s): a wave or particle speed exploded; remedies: scheme.update: musl, a "
+                  "smaller time.cfl, a smooth shape function (gimp, bspline2, cpdi)";
+        break;
+      }
       if (sim.time + dt > t_end) dt = t_end - sim.time;
       sim.dt = dt;
       dt_min = std::min(dt_min, dt);

@@ -95,3 +95,33 @@ TEST_CASE("a plugin given by name only can have its parameters overridden with -
   CHECK(bad.output.find("<--set shape_function=linear>:1:1: error: shape_function.foo: unknown key "
                         "'foo' (this takes no parameters)") != std::string::npos);
 }
+
+TEST_CASE("a collapsing time step stops the run early with the cause (time.min_dt_ratio)",
+          "[output]") {
+  // USL with linear hats on a rigidly translating block: once the leading particle passes
+  // within round-off of a cell face, the node ahead has a tiny mass and f/m feeds back into the
+  // stress (tests/test_invariance.cpp skips this pair for that reason); the stable step fell to
+  // 1e-156 s and the run crawled on to the 1e8-step budget. It must stop when dt falls below
+  // 1e-6 of the first step's (default), naming the cause, with exit code 3, within the ~100
+  // steps the blow-up takes.
+  TempDir dir("dt_collapse");
+  std::filesystem::create_directories(dir.path);
+  std::ofstream(dir.path / "block.yaml")
+      << "grid: {origin: [0], extent: [2.0], cell_size: 0.05}\n"
+         "scheme: {type: single_phase, update: usl}\n"
+         "bodies:\n"
+         "  - {name: block, generator: {type: box, min: [0.5], max: [1.0]}, particles_per_cell: "
+         "2,\n"
+         "     material: {type: linear_elastic, E: 1.0e7, nu: 0.0, density: 2650}, velocity: "
+         "[0.5]}\n"
+         "time: {end: 0.2, cfl: 0.5}\n";
+  auto r = run_loam("run " + (dir.path / "block.yaml").string() + " --quiet --out " +
+                    (dir.path / "out").string());
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 3);
+  CHECK(r.output.find("the stable time step collapsed to") != std::string::npos);
+  CHECK(r.output.find("below time.min_dt_ratio = 1e-06 of the first step's") != std::string::npos);
+  auto s = nlohmann::json::parse(slurp(dir.path / "out" / "summary.json"));
+  CHECK(s["status"] == "unstable");
+  CHECK(s["steps"].get<long>() < 1000);
+}
