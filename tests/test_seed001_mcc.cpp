@@ -280,7 +280,7 @@ TEST_CASE("seed001 MCC: the oedometric element test target and the paper's conve
   CHECK(std::fabs(t.expected / t.settlement() - 1) <= 1e-5);
 }
 
-TEST_CASE("seed001 MCC: closed-form NC oedometric settlement; the element test equals it",
+TEST_CASE("seed001 MCC: the element test equals the closed-form NC oedometric settlement",
           "[verification][mcc]") {
   // Reference: closed_form() (derivation above): eta_K0 from normality with zero lateral strain
   // (elastic strains included), e0 - e_f = lambda ln(p'_f/p'_0) + (lambda - kappa) ln(1 +
