@@ -1,8 +1,20 @@
 // The granular-collapse scene (configs/granular_collapse_2d.yaml) and the friction boundary it
-// uses. Quick tier: the scene run coarse (cell 0.04 m, 5 x 10 cells of column) through the real
-// CLI must collapse and come to rest without NaN. Full tier: the scene as shipped (cell 0.01 m)
-// against the empirical scaling of Lube et al. (2005) (plugins/granular_collapse.cpp), an
-// experimental trend, hence a 15 % band.
+// uses. Reference: the empirical scaling of quasi-2D laboratory collapses of Lube et al. (2005)
+// (plugins/granular_collapse.cpp), at a = H0/L0 = 2: (L_f - L0)/L0 = 2.483, H_f/L0 = 1.320.
+// An experimental trend, so the full tier (the scene as shipped, cell 0.01 m) holds a 15 % band.
+// Resolution study (this scene, --set grid.cell_size=h, 2 particles per cell per axis;
+// deterministic: 1 and 2 threads give identical results):
+//   h (m)     0.04    0.03    0.025   0.02    0.015   0.01    0.0075  0.005
+//   run-out   -31.2%  -24.9%  -18.4%  -12.2%  -3.7%   +6.1%   +12.1%  +21.6%  against Lube 2005
+//   height    +7.9%   +2.3%   -0.2%   -1.2%   -2.5%   -3.6%   -5.8%   -6.9%
+// The run-out is NOT mesh-converged: it grows steadily with refinement (+0.46 L0 from 0.02 to
+// 0.01 m, +0.38 L0 from 0.01 to 0.005 m) and passes the Lube value between 0.015 and 0.01 m,
+// so the shipped scene's agreement (+6 %) is a property of that cell size; at 0.005 m the full
+// tier's 15 % band would fail. It also depends on the time step (cell 0.02: cfl 0.4 / 0.45 / 0.5 /
+// 0.55 give -17.7 / -14.9 / -12.2 / -10.0 %), consistent with the 2 % PIC blend (flip 0.98) being
+// applied per step, so its dissipation scales with the number of steps. The quick tier runs cell
+// 0.02 m (800 particles, ~9000 steps, a few seconds) at the tolerance that resolution achieves.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <vector>
@@ -31,19 +43,31 @@ nlohmann::json collapse(const std::string& name, const std::string& extra) {
 
 }  // namespace
 
-TEST_CASE("granular collapse 2D: a coarse column collapses and comes to rest without NaN",
+TEST_CASE("granular collapse 2D: at cell 0.02 m the deposit is Lube et al. (2005) to 15 % / 3 %",
           "[verification][scene]") {
-  auto s = collapse("granular_collapse", "--set grid.cell_size=0.04");
+  // Reference: Lube et al. (2005), run-out and final height (header). At h = 0.02 m the method
+  // gives run-out -12.2 % and height -1.2 % (resolution study in the header). Tolerances: 15 %
+  // on the run-out (the under-resolved thin front; margin 2.8 points, what a 5 % change of the
+  // time step moves it) and 3 % on the height (margin 1.8 points, the height's change for
+  // +-10 % in the time step). At rest: final max speed below 0.1 m/s (free fall from H0 would
+  // be sqrt(2 g H0) = 2.8 m/s; measured 0.006 m/s).
+  // One thread: the result is the same with 1 and 2 (deterministic), and on a loaded machine
+  // two OpenMP threads of this small run (800 particles) were measured 20-40x slower.
+  auto s = collapse("granular_collapse", "--threads 1 --set grid.cell_size=0.02");
   auto v = s["verify"];
   CHECK(s["status"] == "ok");  // no NaN, no particle left the grid (else exit code 3)
-  // At rest: free fall from H0 would be sqrt(2 g H0) = 2.8 m/s.
   CHECK(v["max_speed_final"].get<double>() < 0.1);
-  CHECK(v["runout"].get<double>() > 0.1);              // it spread (L0 = 0.2 m) ...
-  CHECK(v["height_ratio"].get<double>() < 0.9 * 2.0);  // ... and slumped (H0/L0 = 2)
+  CHECK(std::fabs(v["runout_ratio"].get<double>() / v["lube2005_runout_ratio"].get<double>() - 1) <
+        0.15);
+  CHECK(std::fabs(v["height_ratio"].get<double>() / v["lube2005_height_ratio"].get<double>() - 1) <
+        0.03);
 }
 
 TEST_CASE("granular collapse 2D: deposit within 15 % of Lube et al. (2005)",
           "[verification][scene][full]") {
+  // Reference: Lube et al. (2005). Measured at the shipped 0.01 m: run-out +6.1 %, height
+  // -3.6 %. The 15 % band is the experimental trend's scatter, not this resolution's error,
+  // and it is NOT a converged result (header: +12.1 % at 0.0075 m, +21.6 % at 0.005 m).
   auto s = collapse("granular_collapse_full", "");
   auto v = s["verify"];
   CHECK(s["status"] == "ok");
@@ -56,12 +80,27 @@ TEST_CASE("granular collapse 2D: deposit within 15 % of Lube et al. (2005)",
 
 TEST_CASE("friction boundary: a block sliding on the base decelerates at mu g",
           "[boundary][unit]") {
-  // Coulomb friction (plugins/friction.cpp): a rigid-ish elastic block sliding at v0 on a base
-  // with friction mu decelerates at mu g (g = 10), stopping after v0 / (mu g). With grid
-  // friction only on the base nodes the particles in the first cell row feel part of it, so the
-  // check is on the block's mean velocity after 0.1 s against v0 - mu g t within 15 %, and
-  // against the frictionless case (which must keep v0 to 1e-9).
-  auto run = [](double mu) {
+  // Coulomb friction (plugins/friction.cpp): an elastic block (one cell high) sliding at v0 on
+  // a base with friction mu. References:
+  // (1) Coulomb's law in impulse form: while every loaded base node slides, the tangential
+  //     impulse is mu times the normal impulse, and the normal impulse over [0, t] is the
+  //     weight's, m g t, plus the change of the block's vertical momentum m vy(t) (vy(0) = 0).
+  //     Hence, for the mass-weighted mean velocities, exactly
+  //         vx(t) = v0 - mu (g t + vy(t)),
+  //     checked at every step to 1e-12 m/s (MPM transfers conserve momentum to round-off;
+  //     measured 7e-16).
+  // (2) The rigid-block deceleration mu g: vx(t) = v0 - mu g t, off by mu vy(t), the block's
+  //     vertical vibration about its contact (the uniform initial stress -250 Pa is not the
+  //     geostatic gradient: +-125 Pa at the particles, i.e. |vy| <~ 125/(rho c) = 1.3e-3 m/s).
+  //     Measured: max |vy| = 4.4e-4 m/s, max over the run of |vx - (v0 - mu g t)| = 1.3e-4
+  //     m/s (2e-4 of vx at t = 0.1 s), at t = 0.1 s -1.3e-4 relative. Tolerance 3e-4
+  //     relative over the whole run (was 15 % at t = 0.1 s only).
+  // And the frictionless case must keep v0 to 1e-9.
+  struct Run {
+    double vx = 0, t = 0, worst_coulomb = 0, worst_impulse = 0;
+  };
+  const double g = 10, v0 = 1.0;
+  auto run = [&](double mu) {
     const std::string yaml =
         "grid: {extent: [2.0, 0.4], cell_size: 0.05}\n"
         "gravity: [0, -10]\n"
@@ -76,24 +115,34 @@ TEST_CASE("friction boundary: a block sliding on the base decelerates at mu g",
         "  - {type: friction, face: y-, coefficient: " +
         std::to_string(mu) + "}\ntime: {end: 1}\n";
     auto sim = loam_test::make_simulation<2>(yaml);
-    while (sim->time < 0.1) loam_test::advance(*sim, 1);
-    const auto& P = sim->particles;
-    double mv = 0, m = 0;
-    for (size_t i = 0; i < P.size(); ++i) {
-      mv += P.col(P.mass)[i] * P.col(P.velocity, 0)[i];
-      m += P.col(P.mass)[i];
+    Run r;
+    while (sim->time < 0.1) {
+      loam_test::advance(*sim, 1);
+      const auto& P = sim->particles;
+      double mx = 0, my = 0, m = 0;
+      for (size_t i = 0; i < P.size(); ++i) {
+        mx += P.col(P.mass)[i] * P.col(P.velocity, 0)[i];
+        my += P.col(P.mass)[i] * P.col(P.velocity, 1)[i];
+        m += P.col(P.mass)[i];
+      }
+      r.vx = mx / m, r.t = sim->time;
+      const double coulomb = v0 - mu * g * r.t;
+      r.worst_coulomb = std::max(r.worst_coulomb, std::fabs(r.vx / coulomb - 1));
+      r.worst_impulse = std::max(r.worst_impulse, std::fabs(r.vx - (v0 - mu * (g * r.t + my / m))));
     }
-    return std::pair{mv / m, sim->time};
+    return r;
   };
-  auto [v_free, t_free] = run(0.0);
-  auto [v_fric, t] = run(0.3);
-  const double expected = 1.0 - 0.3 * 10 * t;
+  const Run free = run(0.0), fric = run(0.3);
+  const double expected = v0 - 0.3 * g * fric.t;
   std::printf(
-      "friction: mean velocity %.4f m/s at t = %.4f s (Coulomb: %.4f, error %.1f %%); "
+      "friction: mean velocity %.6f m/s at t = %.4f s (Coulomb v0 - mu g t: %.6f, error "
+      "%+.2e; worst over the run %.2e); impulse balance v0 - mu (g t + vy): worst %.1e m/s; "
       "frictionless %.10f m/s\n",
-      v_fric, t, expected, 100 * (v_fric / expected - 1), v_free);
-  CHECK(std::fabs(v_free - 1.0) < 1e-9);
-  CHECK(std::fabs(v_fric / expected - 1) < 0.15);
+      fric.vx, fric.t, expected, fric.vx / expected - 1, fric.worst_coulomb, fric.worst_impulse,
+      free.vx);
+  CHECK(std::fabs(free.vx - v0) < 1e-9);
+  CHECK(fric.worst_impulse < 1e-12);
+  CHECK(fric.worst_coulomb < 3e-4);
 }
 
 TEST_CASE("granular collapse 2D: an unknown body in verify is a located error naming the bodies",

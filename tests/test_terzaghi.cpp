@@ -1,8 +1,9 @@
 // Terzaghi one-way consolidation (plugins/terzaghi.hpp series, plugins/terzaghi.cpp reference;
-// VERIFICATION.md C). The series are checked against classic tables, their own limits and
-// boundary conditions and each other; the reference plugin is checked by filling the
-// pore_pressure field with known values (no two-phase scheme exists yet) and through the CLI
-// for its located errors.
+// VERIFICATION.md C). The series are checked against classic tables (U(T) and T(U)), a sum
+// written out here, closed forms, their own limits and boundary conditions, each other, and the
+// two-way layer that tests/test_hydraulic_boundaries.cpp maps onto them; the reference plugin is
+// checked by filling the pore_pressure field with known values (no two-phase scheme exists yet) and
+// through the CLI for its located errors.
 #include <yaml-cpp/yaml.h>
 
 #include <catch2/catch.hpp>
@@ -131,6 +132,131 @@ TEST_CASE("terzaghi: U equals one minus the mean pore pressure", "[reference][un
   }
   std::printf("terzaghi: |1 - mean(p) - U| max %.2e\n", worst);
   CHECK(worst < 1e-11);
+}
+
+namespace {
+
+/// Terzaghi's one-way series written out here, independently of plugins/terzaghi.hpp:
+/// p/p0 = sum_{m>=0} (2/M) sin(M z'/H) exp(-M^2 T), M = (2m+1) pi/2, z' down from the drained
+/// top, summed over a fixed 20000 terms (at T >= 0.005 the last term is below 1e-300: the
+/// truncation is nil, the rounding ~1e-15).
+double hand_pressure(double zeta, double T) {
+  double sum = 0;
+  for (int m = 0; m < 20000; ++m) {
+    const double M = (2 * m + 1) * M_PI / 2;
+    sum += 2 / M * std::sin(M * zeta) * std::exp(-M * M * T);
+  }
+  return sum;
+}
+
+/// U = 1 - sum_{m>=0} (2/M^2) exp(-M^2 T), the same fixed 20000 terms.
+double hand_degree(double T) {
+  double sum = 0;
+  for (int m = 0; m < 20000; ++m) {
+    const double M = (2 * m + 1) * M_PI / 2;
+    sum += 2 / (M * M) * std::exp(-M * M * T);
+  }
+  return 1 - sum;
+}
+
+/// The time factor at which terzaghi_degree reaches U (bisection; U(T) is increasing).
+double time_factor_for(double U) {
+  double lo = 0, hi = 10;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (terzaghi_degree(mid) < U ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+TEST_CASE("terzaghi: the plugin's series equal a hand-written sum", "[reference][unit]") {
+  // Reference: hand_pressure / hand_degree above (the textbook Fourier sums, written out here),
+  // at z'/H = 0.1 ... 1 and T = 0.005 (the plugin's image-series branch, T < 0.01), 0.02, 0.05,
+  // 0.1, 0.2, 0.5, 1. Tolerance 1e-12 absolute (both sides are exact to ~1e-15).
+  // Hand values printed, e.g. p/p0(z'/H = 0.5, T = 0.2) = 0.553176, base at T = 1: 0.107977
+  // = (4/pi) exp(-pi^2/4) to 1e-9 (the next term is 4/(3 pi) exp(-9 pi^2/4) = 2e-10).
+  double worst_p = 0, worst_u = 0;
+  for (double T : {0.005, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0}) {
+    std::printf("terzaghi: T = %-5g", T);
+    for (double zeta : {0.1, 0.25, 0.5, 0.75, 1.0}) {
+      const double hand = hand_pressure(zeta, T);
+      worst_p = std::max(worst_p, std::fabs(terzaghi_pressure(zeta, T) - hand));
+      std::printf("  p/p0(%.2f) = %.6f", zeta, hand);
+    }
+    worst_u = std::max(worst_u, std::fabs(terzaghi_degree(T) - hand_degree(T)));
+    std::printf("  U = %.6f\n", hand_degree(T));
+  }
+  const double base1 = 4 / M_PI * std::exp(-M_PI * M_PI / 4);
+  std::printf(
+      "terzaghi: plugin - hand sum: max |dp/p0| %.1e, max |dU| %.1e; p/p0(1, T = 1) %.9f "
+      "(4/pi exp(-pi^2/4) = %.9f)\n",
+      worst_p, worst_u, terzaghi_pressure(1, 1), base1);
+  CHECK(worst_p < 1e-12);
+  CHECK(worst_u < 1e-12);
+  CHECK(std::fabs(terzaghi_pressure(1, 1) - base1) < 1e-9);
+}
+
+TEST_CASE("terzaghi: time factors for a given degree of consolidation (T50, T60, T90)",
+          "[reference][unit]") {
+  // References: (1) the classic table of T against U (reproduced in most soil mechanics
+  // texts), 3 decimals: U = 0.1 .. 0.95 -> T = 0.008, 0.031, 0.071, 0.126, 0.197, 0.286,
+  // 0.403, 0.567, 0.848, 1.129;
+  // tolerance 5e-4 (half the last decimal). Some tables print T60 = 0.287: the series gives
+  // 0.28640, which rounds to 0.286 (0.287 is 6e-4 off, outside its own rounding; printed).
+  // Checking T(U) rather than U(T) keeps the table's rounding where it is (U(0.197) = 0.50034).
+  // (2) closed forms: T = pi U^2 / 4 below U ~ 0.5 (short-time solution, exact to exp(-1/T):
+  // at U = 0.2, T = pi/100 to 1e-12) and T = (4/pi^2) ln(8 / (pi^2 (1 - U))) above U ~ 0.6
+  // (first Fourier term; at U = 0.9 the second term shifts T by 2.4e-9). Tolerance 1e-8.
+  const std::vector<std::pair<double, double>> table = {
+      {0.1, 0.008}, {0.2, 0.031}, {0.3, 0.071}, {0.4, 0.126}, {0.5, 0.197},
+      {0.6, 0.286}, {0.7, 0.403}, {0.8, 0.567}, {0.9, 0.848}, {0.95, 1.129}};
+  double worst = 0;
+  for (auto [U, Ttab] : table) {
+    const double T = time_factor_for(U);
+    worst = std::max(worst, std::fabs(T - Ttab));
+    std::printf("terzaghi: T(U = %.2f) = %.5f (table %.3f, diff %+.1e)\n", U, T, Ttab, T - Ttab);
+  }
+  const double T20 = M_PI / 100, T90 = 4 / (M_PI * M_PI) * std::log(8 / (M_PI * M_PI * 0.1));
+  std::printf(
+      "terzaghi: max |T - table| %.1e; T60 - 0.287 = %+.1e; T(0.2) - pi/100 = %.1e, "
+      "T(0.9) - (4/pi^2) ln(80/pi^2) = %.1e\n",
+      worst, time_factor_for(0.6) - 0.287, time_factor_for(0.2) - T20, time_factor_for(0.9) - T90);
+  CHECK(worst <= 5e-4);
+  CHECK(std::fabs(time_factor_for(0.2) - T20) < 1e-8);
+  CHECK(std::fabs(time_factor_for(0.9) - T90) < 1e-8);
+}
+
+TEST_CASE("terzaghi: a layer drained at both faces is the one-way series on half its height",
+          "[reference][unit]") {
+  // The plugin is one-way only; two-way drainage (tests/test_hydraulic_boundaries.cpp) uses it
+  // on the half height H = L/2 with z' from the nearer drained face. Reference: the two-way
+  // series of a layer of thickness L drained at x = 0 and x = L, written out here,
+  //   p/p0 = sum_{n odd} (4/(n pi)) sin(n pi x/L) exp(-n^2 pi^2 c_v t / L^2),
+  //   U    = 1 - sum_{n odd} (8/(n^2 pi^2)) exp(-n^2 pi^2 c_v t / L^2),
+  // against terzaghi_pressure(1 - |x - H|/H, T) and terzaghi_degree(T), T = c_v t / H^2, at
+  // x/L = 0 .. 1 and T = 0.005 .. 1. Tolerance 1e-12 absolute.
+  const double L = 2.0, H = L / 2, cv = 0.3;
+  double worst_p = 0, worst_u = 0;
+  for (double T : {0.005, 0.05, 0.2, 0.5, 1.0}) {
+    const double t = T * H * H / cv;
+    double u = 0;
+    for (int n = 1; n < 40000; n += 2)
+      u += 8 / (n * n * M_PI * M_PI) * std::exp(-n * n * M_PI * M_PI * cv * t / (L * L));
+    worst_u = std::max(worst_u, std::fabs(terzaghi_degree(T) - (1 - u)));
+    for (int j = 0; j <= 20; ++j) {
+      const double x = L * j / 20;
+      double p = 0;
+      for (int n = 1; n < 40000; n += 2)
+        p += 4 / (n * M_PI) * std::sin(n * M_PI * x / L) *
+             std::exp(-n * n * M_PI * M_PI * cv * t / (L * L));
+      worst_p = std::max(worst_p, std::fabs(terzaghi_pressure(1 - std::fabs(x - H) / H, T) - p));
+    }
+  }
+  std::printf("terzaghi two-way: max |dp/p0| %.1e, max |dU| %.1e\n", worst_p, worst_u);
+  CHECK(worst_p < 1e-12);
+  CHECK(worst_u < 1e-12);
 }
 
 namespace {
