@@ -146,7 +146,8 @@ time:
 )");
   require_rejected(s, r,
                    {s.error_at(10, 3, "time.steps",
-                               "unknown key 'steps'; valid keys are: end, cfl, dt, max_steps")});
+                               "unknown key 'steps'; valid keys are: end, cfl, dt, max_steps, "
+                               "min_dt_ratio")});
 }
 
 TEST_CASE("misspelt key inside a body: unknown key and the missing one", "[bad_config]") {
