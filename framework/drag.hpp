@@ -3,7 +3,7 @@
 // two-phase (saturated) schemes. A drag law is chosen by name in a two-phase scheme's config and
 // owned by that scheme; nothing else calls it.
 //
-// Convention (VERIFICATION.md D). The drag force on the water, per unit MIXTURE volume, is
+// Convention (docs/verification.md D). The drag force on the water, per unit MIXTURE volume, is
 //     f = -Q (w - v),   Q >= 0 in kg/(m^3 s) = N s/m^4,
 // with w the water and v the solid (skeleton) velocity; the skeleton receives +Q (w - v).
 // Q is defined so that steady seepage obeys Darcy's law for the flux q = n (w - v):
@@ -16,8 +16,8 @@
 // skeleton); an explicit drag update needs dt < ~2 n rho_w / Q, which low permeability makes
 // tiny; an implicit (node-wise) drag update has no such limit.
 //
-// The Ergun law of VERIFICATION.md D has an extra buoyancy-like term -p_w grad(n); it depends on
-// the pore pressure and the porosity gradient, which only the scheme has, so the SCHEME adds it.
+// The Ergun law of docs/verification.md D has an extra buoyancy-like term -p_w grad(n); it depends
+// on the pore pressure and the porosity gradient, which only the scheme has, so the SCHEME adds it.
 // A drag plugin returns Q only.
 //
 // Hot path: schemes call coefficient() once per batch (per particle block, per material range or

@@ -26,7 +26,7 @@
 //
 // Tension positive, Voigt xx yy zz xy yz xz. 2D is plane strain (eps_zz = 0, so sigma_zz comes
 // from lambda tr(eps)), 1D is laterally confined (sigma_yy = sigma_zz = lambda tr(eps) / J), as
-// in VERIFICATION.md A. The 2D logarithm is closed form (no eigenvectors: eps = 1/2 ln J I +
+// in docs/verification.md A. The 2D logarithm is closed form (no eigenvectors: eps = 1/2 ln J I +
 // beta dev(B)), 1D is scalar; 3D takes the eigenvalues of B = F F^T in closed form and the
 // logarithm (and V^-1 for R) by Newton's divided differences, without eigenvectors. An inverted
 // particle (det F <= 0) gives a non-finite stress.

@@ -3,7 +3,7 @@
 // cutoff) whose cohesion c, friction angle phi and dilation angle psi fall linearly from their
 // peak to their residual values as the equivalent plastic deviatoric strain
 //   eps_q^p = sum over steps of sqrt(2/3 e^p : e^p)     (state field plastic_strain_eq)
-// grows from softening_start to softening_end (VERIFICATION.md B; the slope seed uses this):
+// grows from softening_start to softening_end (docs/verification.md B; the slope seed uses this):
 //   t = clamp((eps_q^p - softening_start) / (softening_end - softening_start), 0, 1),
 //   c = c_peak + t (c_residual - c_peak), and likewise phi and psi (in degrees).
 // Below softening_start the model is perfectly plastic at peak strength, beyond softening_end

@@ -1,7 +1,7 @@
 // Reference: final height of a laterally confined elastic column consolidated under a surface
-// load q (seed 001 large strain, VERIFICATION.md C "Seed 001 large strain"). Once the excess pore
-// pressure has drained, the effective stress is -q everywhere (no self-weight), and the
-// exact height h = J H0 follows from the stress-strain law along the column axis (nu = 0, M the
+// load q (seed 001 large strain, docs/verification.md C "Seed 001 large strain"). Once the excess
+// pore pressure has drained, the effective stress is -q everywhere (no self-weight), and the exact
+// height h = J H0 follows from the stress-strain law along the column axis (nu = 0, M the
 // constrained modulus):
 //   jaumann (hypoelastic, Cauchy stress, Jaumann rate): sigma = M ln J   ->  J = exp(-q / M)
 //   hencky  (hyperelastic, Kirchhoff stress J sigma):   J sigma = M ln J ->  ln J + (q/M) J = 0

@@ -1,4 +1,4 @@
-// Darcy drag (VERIFICATION.md D): linear in the relative velocity, per unit mixture volume
+// Darcy drag (docs/verification.md D): linear in the relative velocity, per unit mixture volume
 //     Q = n^2 mu_w / kappa = n^2 gamma_w / k,   k = kappa gamma_w / mu_w,   gamma_w = rho_w g,
 // with n the current porosity (framework/drag.hpp has the convention; seed 001's per-unit-water-
 // volume coefficient n gamma_w / k is Q / n). Given either the hydraulic conductivity k (m/s,

@@ -1,5 +1,5 @@
 // Reference: laterally confined elastic column under gravity on a fixed base
-// (VERIFICATION.md A): sigma_v(z) = -rho g (H - z), sigma_h = nu/(1-nu) sigma_v,
+// (docs/verification.md A): sigma_v(z) = -rho g (H - z), sigma_h = nu/(1-nu) sigma_v,
 // u_v(z) = -rho g (H z - z^2/2) / M with M = E(1-nu)/((1+nu)(1-2nu)); the top settles
 // rho g H^2 / (2M). Vertical is the last axis; z is measured from the column's base, and the
 // exact fields are evaluated at each particle's initial position (small strain).

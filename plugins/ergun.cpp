@@ -1,4 +1,4 @@
-// Ergun drag (VERIFICATION.md D, seed 003): laminar Kozeny-Carman part plus the inertial
+// Ergun drag (docs/verification.md D, seed 003): laminar Kozeny-Carman part plus the inertial
 // (Forchheimer) part, per unit mixture volume (framework/drag.hpp has the convention)
 //     Q = n^2 (mu_w / kappa + n rho_w F / sqrt(kappa) |w - v|),
 //     kappa = d^2 n^3 / (A (1 - n)^2)   (Kozeny-Carman, from the CURRENT porosity n),

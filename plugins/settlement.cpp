@@ -1,6 +1,6 @@
 // Reference: final settlement of a laterally confined column under a surface load, for any
-// skeleton material (seed 001 MCC, VERIFICATION.md C "Seed 001 MCC"). It measures; the value to
-// compare with comes from elsewhere (for an elastoplastic skeleton: the oedometric element test
+// skeleton material (seed 001 MCC, docs/verification.md C "Seed 001 MCC"). It measures; the value
+// to compare with comes from elsewhere (for an elastoplastic skeleton: the oedometric element test
 // of the same material from the same initial state to the same final vertical effective stress,
 // `loam element-test`, given here as expected_settlement).
 //   final_height     = sum V_p / A0, A0 = V0 / H0 (m): the column's current volume over its

@@ -1,5 +1,5 @@
 // Sinusoidal field a * sin(k . (x - x0)), e.g. the vibrating bar's first mode
-// v(x, 0) = v0 sin(pi x / 2L) (VERIFICATION.md A): amplitude [v0], wavenumber [pi/(2L)].
+// v(x, 0) = v0 sin(pi x / 2L) (docs/verification.md A): amplitude [v0], wavenumber [pi/(2L)].
 #include <cmath>
 
 #include "framework/registry.hpp"

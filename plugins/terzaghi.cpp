@@ -1,4 +1,4 @@
-// Reference: Terzaghi one-dimensional consolidation with one-way drainage (VERIFICATION.md C;
+// Reference: Terzaghi one-dimensional consolidation with one-way drainage (docs/verification.md C;
 // series in plugins/terzaghi.hpp). The column is a body whose top face (the last axis, upward)
 // is drained and whose base is impermeable; its excess pore pressure starts at p0 = `load`.
 //

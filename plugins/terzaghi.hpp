@@ -1,8 +1,8 @@
 #pragma once
-// Terzaghi one-dimensional consolidation, one-way drainage (VERIFICATION.md C): a layer of height
-// H, drained at the top (p = 0), impermeable at the bottom (dp/dz = 0), uniform initial excess
-// pore pressure p0. With zeta = z'/H (z' measured down from the drained top, 0 <= zeta <= 1) and
-// the time factor T = c_v t / H^2:
+// Terzaghi one-dimensional consolidation, one-way drainage (docs/verification.md C): a layer of
+// height H, drained at the top (p = 0), impermeable at the bottom (dp/dz = 0), uniform initial
+// excess pore pressure p0. With zeta = z'/H (z' measured down from the drained top, 0 <= zeta <= 1)
+// and the time factor T = c_v t / H^2:
 //     p/p0 = sum_{m>=0} (2/M) sin(M zeta) exp(-M^2 T),      M = (2m+1) pi/2      (Fourier)
 //     U    = 1 - sum_{m>=0} (2/M^2) exp(-M^2 T)             (degree of consolidation)
 // The Fourier series converges slowly for small T (~180 terms at T = 1e-4, ~1.5e4 at 1e-8) and

@@ -1,4 +1,4 @@
-// Reference: first mode of a bar fixed at x = 0 and free at x = L (VERIFICATION.md A).
+// Reference: first mode of a bar fixed at x = 0 and free at x = L (docs/verification.md A).
 // v(x,t) = v0 sin(pi x / 2L) cos(w t), u = (v0/w) sin(pi x / 2L) sin(w t), w = (pi/2L) sqrt(E/rho).
 // Metrics: period from the zero crossings and amplitude of the first-mode coordinate
 //   q(t) = sum m u phi / sum m phi^2,  phi = sin(pi x0 / 2L)

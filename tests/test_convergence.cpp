@@ -1,4 +1,4 @@
-// Convergence of the shape functions on the vibrating bar (VERIFICATION.md A, "Convergence"),
+// Convergence of the shape functions on the vibrating bar (docs/verification.md A, "Convergence"),
 // through the real `loam compare` sweep: errors at 4 resolutions, observed order by a least-
 // squares fit of log(error) against log(h), as in tools/convergence.py and docs/convergence.md.
 #include <catch2/catch.hpp>
@@ -29,7 +29,9 @@ Sweep run_bar_sweep(const std::filesystem::path& dir) {
   std::vector<std::string> head;
   std::stringstream hs(line);
   for (std::string c; std::getline(hs, c, ',');) head.push_back(c);
-  auto col = [&](const std::string& n) { return size_t(std::find(head.begin(), head.end(), n) - head.begin()); };
+  auto col = [&](const std::string& n) {
+    return size_t(std::find(head.begin(), head.end(), n) - head.begin());
+  };
   Sweep s;
   while (std::getline(in, line)) {
     std::vector<std::string> c;
@@ -65,10 +67,11 @@ TEST_CASE("vibrating bar convergence: smooth shape functions order 2, linear los
   for (const auto& [shape, e] : s.period) {
     REQUIRE(e.size() == 4);
     const double p = observed_order(e), d = observed_order(s.displacement.at(shape));
-    std::printf("%-9s period error order %.2f (h = 1 .. 0.125: %.2e .. %.2e), displacement error "
-                "order %.2f (%.2e .. %.2e)\n",
-                shape.c_str(), p, e.rbegin()->second, e.begin()->second, d,
-                s.displacement.at(shape).rbegin()->second, s.displacement.at(shape).begin()->second);
+    std::printf(
+        "%-9s period error order %.2f (h = 1 .. 0.125: %.2e .. %.2e), displacement error "
+        "order %.2f (%.2e .. %.2e)\n",
+        shape.c_str(), p, e.rbegin()->second, e.begin()->second, d,
+        s.displacement.at(shape).rbegin()->second, s.displacement.at(shape).begin()->second);
     if (shape == "linear") {
       // Particles cross cells (amplitude 0.16 m vs h down to 0.125 m): the error grows.
       CHECK(p < 0.5);
@@ -78,7 +81,8 @@ TEST_CASE("vibrating bar convergence: smooth shape functions order 2, linear los
       CHECK(p > 1.7);
       CHECK(p < 2.5);
       // At the finest grid the field error is at least 10x below linear's.
-      CHECK(s.displacement.at(shape).begin()->second * 10 < s.displacement.at("linear").begin()->second);
+      CHECK(s.displacement.at(shape).begin()->second * 10 <
+            s.displacement.at("linear").begin()->second);
     }
   }
 }
@@ -91,9 +95,10 @@ TEST_CASE("soft column at the finest grid: smooth shape functions beat linear 3x
   std::map<std::string, double> err;
   for (std::string shape : {"linear", "gimp", "cpdi", "bspline2"}) {
     TempDir dir("soft_" + shape);
-    auto s = loam_test::run_scene("soft_column_2d.yaml", dir.path,
-                                  "--threads 2 --set shape_function=" + shape +
-                                      " --set grid.cell_size=0.015625 --set 'grid.extent=[0.25, 1.125]'");
+    auto s = loam_test::run_scene(
+        "soft_column_2d.yaml", dir.path,
+        "--threads 2 --set shape_function=" + shape +
+            " --set grid.cell_size=0.015625 --set 'grid.extent=[0.25, 1.125]'");
     err[shape] = s["verify"]["stress_error_l2"].get<double>();
     std::printf("soft column h = 1/64, %-8s: stress L2 error %.4f\n", shape.c_str(), err[shape]);
   }

@@ -368,7 +368,7 @@ TEST_CASE("cpdi stops with a clear message: inverted, too stretched, corner outs
   }
 }
 
-TEST_CASE("vibrating bar with cpdi through the CLI: period and energy (VERIFICATION.md A)",
+TEST_CASE("vibrating bar with cpdi through the CLI: period and energy (docs/verification.md A)",
           "[shape][verification]") {
   // T = 4L/c = 10 s; tolerances as for linear (issue 3): period error < 1 %, energy drift < 1 %.
   loam_test::TempDir dir("bar_cpdi");

@@ -1,8 +1,8 @@
 // Drag laws (plugins/darcy.cpp, plugins/ergun.cpp) against hand-computed values
-// (VERIFICATION.md D). Convention (framework/drag.hpp): Q is per unit MIXTURE volume, the force
-// on the water is -Q (w - v), and Darcy's law q = n (w - v) = -(k/gamma_w) grad p gives
-// Q = n^2 gamma_w / k = n^2 mu_w / kappa. Seed 001's coefficient per unit WATER volume,
-// n gamma_w / k, is Q / n. No scheme uses drag yet, so parameters are validated here through
+// (docs/verification.md D). Convention (framework/drag.hpp): Q is per unit MIXTURE volume, the
+// force on the water is -Q (w - v), and Darcy's law q = n (w - v) = -(k/gamma_w) grad p gives Q =
+// n^2 gamma_w / k = n^2 mu_w / kappa. Seed 001's coefficient per unit WATER volume, n gamma_w / k,
+// is Q / n. No scheme uses drag yet, so parameters are validated here through
 // loam::validate_plugin, exactly as a scheme's `drag:` key will validate them.
 #include <yaml-cpp/yaml.h>
 
@@ -82,7 +82,7 @@ TEST_CASE("darcy: Q from the hydraulic conductivity against hand values", "[drag
 TEST_CASE("darcy: Q from the intrinsic permeability against hand values", "[drag][unit]") {
   // Reference (seed 002): kappa = 1e-10 m^2, mu_w = 1e-3 Pa s, n = 0.3:
   //   Q = n^2 mu_w / kappa = 0.09 * 1e-3 / 1e-10 = 9e5 kg/(m^3 s),
-  //   k = kappa gamma_w / mu_w = 1e-10 * 9810 / 1e-3 = 9.81e-4 m/s (VERIFICATION.md C: 1e-3).
+  //   k = kappa gamma_w / mu_w = 1e-10 * 9810 / 1e-3 = 9.81e-4 m/s (docs/verification.md C: 1e-3).
   // With mu_w = 2e-3 both scale: Q = 1.8e6, k = 4.905e-4. Tolerance: 1e-14 relative.
   auto drag = make_drag("drag: {type: darcy, intrinsic_permeability: 1.0e-10}");
   const double Q = Q_of(*drag, 0.3, 0.0), k = drag->hydraulic_conductivity(0.3);
@@ -139,7 +139,7 @@ TEST_CASE("ergun: Q against hand values at two relative speeds", "[drag][unit]")
   //   |w - v| = 0.01 m/s: Q = 135000 + 1.05e6 * 0.01 = 145500 kg/(m^3 s)
   //   |w - v| = 0.1 m/s:  Q = 135000 + 1.05e6 * 0.1  = 240000
   //   |w - v| = 0:        Q = 135000 (laminar)
-  // The same Q from the formula as written in VERIFICATION.md D (pow, sqrt) is also compared,
+  // The same Q from the formula as written in docs/verification.md D (pow, sqrt) is also compared,
   // and so is the classical Ergun gradient with flux U = n |w - v|:
   //   Q |w - v| / n = A mu (1-n)^2 U / (n^3 d^2) + B rho (1-n) U^2 / (n^3 d).
   // Tolerance: 1e-13 relative.

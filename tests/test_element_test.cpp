@@ -1,6 +1,6 @@
 // The element-test driver (framework/element_test.hpp) on linear elasticity, where every path has
-// a closed form (VERIFICATION.md B: the driver itself must be exact before it judges soils), and
-// `loam element-test` through the command line: CSV, exit codes, located errors, no overwrite.
+// a closed form (docs/verification.md B: the driver itself must be exact before it judges soils),
+// and `loam element-test` through the command line: CSV, exit codes, located errors, no overwrite.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>

@@ -1,6 +1,6 @@
 // Unit tests of the two large-deformation formulations of linear_elastic (issue 6 item 5,
-// VERIFICATION.md C "Seed 001 large strain"): jaumann (hypoelastic Cauchy stress, Jaumann rate)
-// and hencky (hyperelastic Kirchhoff stress of the logarithmic strain). Paths run through the
+// docs/verification.md C "Seed 001 large strain"): jaumann (hypoelastic Cauchy stress, Jaumann
+// rate) and hencky (hyperelastic Kirchhoff stress of the logarithmic strain). Paths run through the
 // element-test driver (framework/element_test.hpp) and through one material point in 1D, 2D and
 // 3D whose volume and deformation gradient are updated as the schemes do (V *= det(I + L dt),
 // F <- (I + L dt) F) before the material's stress update. Tension positive throughout.
@@ -195,7 +195,7 @@ TEST_CASE("linear_elastic: jaumann oedometer gives sigma = M ln(h/H) to the inte
   }
 }
 
-TEST_CASE("linear_elastic: VERIFICATION.md C seed 001 final heights under 50 kPa",
+TEST_CASE("linear_elastic: docs/verification.md C seed 001 final heights under 50 kPa",
           "[material][unit]") {
   // E = 100 kPa, nu = 0 (M = 100 kPa), H = 1 m, confined (1D) load 50 kPa.
   // jaumann: sigma = M ln(h/H) -> h = exp(-0.5) = 0.6065 m (load applied in n increments of

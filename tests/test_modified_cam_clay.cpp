@@ -1,4 +1,4 @@
-// Unit tests of the modified_cam_clay material (VERIFICATION.md section B): laboratory paths
+// Unit tests of the modified_cam_clay material (docs/verification.md section B): laboratory paths
 // through the element-test driver (framework/element_test.hpp), single material points in 1D,
 // 2D and 3D driven directly through MaterialBatch, and the parameter checks through the command
 // line. In the formulas p', q, strains and pc are compression positive (soil mechanics); the
@@ -94,7 +94,7 @@ struct Point : loam_test::MaterialPoint<D> {
 
 TEST_CASE("modified_cam_clay: drained triaxial from the NCL ends on the critical state line",
           "[material][unit]") {
-  // Reference: VERIFICATION.md B (drained triaxial from an NC state ends on q/p' = M). At
+  // Reference: docs/verification.md B (drained triaxial from an NC state ends on q/p' = M). At
   // constant confining stress dq = 3 dp', so the critical state is p'_cs = 3 p'0/(3 - M),
   // q_cs = M p'_cs, and (MCC: the CSL lies at pc = 2p' on the NCL) the void ratio there is
   // e_cs = e0 + lambda ln(p'0/p'_cs) - (lambda - kappa) ln 2. Tolerance 1% (the approach to
@@ -122,7 +122,7 @@ TEST_CASE("modified_cam_clay: drained triaxial from the NCL ends on the critical
 TEST_CASE("modified_cam_clay: heavily overconsolidated drained triaxial softens to the CSL",
           "[material][unit]") {
   // Dry side: OCR 10, peak above the CSL then dilation and softening down to q/p' = M at the
-  // same p'_cs = 3 p'0/(3 - M) (VERIFICATION.md B critical state). Tolerance 1% at 80% axial
+  // same p'_cs = 3 p'0/(3 - M) (docs/verification.md B critical state). Tolerance 1% at 80% axial
   // strain (2% above M at 40%).
   const auto r = run(mcc(", ocr: 10"), path("triaxial_drained", 0.8, 800));
   double peak = 0;
@@ -145,7 +145,7 @@ TEST_CASE("modified_cam_clay: heavily overconsolidated drained triaxial softens 
 
 TEST_CASE("modified_cam_clay: undrained triaxial from the NCL ends at the closed-form mean stress",
           "[material][unit]") {
-  // Reference: VERIFICATION.md B. Undrained (v constant): the elastic volumetric strain
+  // Reference: docs/verification.md B. Undrained (v constant): the elastic volumetric strain
   // cancels the plastic one, so kappa ln(p'/p'0) = -(lambda - kappa) ln(pc/pc0) along the
   // whole path (exact for the e-ln p' laws). From the NCL (pc0 = p'0) to the critical state
   // (pc = 2p'): lambda ln(p'/p'0) = -(lambda - kappa) ln 2, i.e.
@@ -177,7 +177,7 @@ TEST_CASE("modified_cam_clay: undrained triaxial from the NCL ends at the closed
 
 TEST_CASE("modified_cam_clay: isotropic and oedometric loading follow the NCL slope lambda",
           "[material][unit]") {
-  // Reference: VERIFICATION.md B, e = e_N - lambda ln p' on the NCL. Isotropic loading from
+  // Reference: docs/verification.md B, e = e_N - lambda ln p' on the NCL. Isotropic loading from
   // pc0 = p'0 stays on the NCL from the first increment: exact up to round-off (tolerance
   // 1e-9 relative). Oedometric loading from an isotropic state turns onto the K0 line (constant
   // q/p'), along which p'/pc is constant, so the slope is lambda once the stress ratio has
@@ -204,7 +204,7 @@ TEST_CASE("modified_cam_clay: isotropic and oedometric loading follow the NCL sl
 }
 
 TEST_CASE("modified_cam_clay: unloading follows the swelling slope kappa", "[material][unit]") {
-  // Reference: VERIFICATION.md B (unloading slope kappa): e = e_k - kappa ln p' inside the
+  // Reference: docs/verification.md B (unloading slope kappa): e = e_k - kappa ln p' inside the
   // yield surface, exact for the integrated elastic law. Isotropic: load 20% volumetric strain,
   // unload 2%; oedometer: load 20% axial, unload 1% (stays elastic). Slope by least squares
   // over the unloading rows; tolerance 1% (measured: round-off). pc must not change.

@@ -1,4 +1,4 @@
-// Unit tests of the mohr_coulomb material at one material point (VERIFICATION.md section B),
+// Unit tests of the mohr_coulomb material at one material point (docs/verification.md section B),
 // driven directly through MaterialBatch, and its parameter checks through the command line.
 // Formulas here use compression positive (sigma'_1 >= sigma'_3), the material tension positive.
 #include <Eigen/Dense>

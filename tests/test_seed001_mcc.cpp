@@ -1,4 +1,4 @@
-// Seed 001 MCC consolidation (configs/seed001_mcc.yaml; VERIFICATION.md C, "Seed 001 MCC"): a
+// Seed 001 MCC consolidation (configs/seed001_mcc.yaml; docs/verification.md C, "Seed 001 MCC"): a
 // 1 m Modified Cam Clay column, normally consolidated at the isotropic effective stress 50 kPa,
 // under 150 kPa more. Two references for the final settlement:
 // - the closed-form normally consolidated oedometric settlement (e-ln p' on the NCL at the K0

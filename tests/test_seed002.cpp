@@ -1,4 +1,4 @@
-// Seed 002 dynamic (oedometric) consolidation (VERIFICATION.md C, "Seed 002"; seed paper
+// Seed 002 dynamic (oedometric) consolidation (docs/verification.md C, "Seed 002"; seed paper
 // section 3.2, Figs. 5-6): configs/seed002_dynamic_consolidation.yaml (fixed, impervious base)
 // and configs/seed002_dynamic_consolidation_absorbing.yaml (impermeable viscous absorbing base),
 // through the real CLI. Late times against Terzaghi's series (c_v = kappa M / mu_w = 1 m^2/s,

@@ -747,7 +747,8 @@ TEST_CASE("every shape function: a particle on a grid face is carried by the fac
 
 TEST_CASE("vibrating bar with gimp and bspline2 through the CLI: period and energy",
           "[shape][verification]") {
-  // VERIFICATION.md A: T = 10 s; tolerances from issue 3/4: period error < 1 %, energy drift < 1 %.
+  // docs/verification.md A: T = 10 s; tolerances from issue 3/4: period error < 1 %, energy drift <
+  // 1 %.
   for (std::string shape : {"gimp", "bspline2"}) {
     loam_test::TempDir dir("bar_" + shape);
     auto s = loam_test::run_scene("vibrating_bar.yaml", dir.path, "--set shape_function=" + shape);

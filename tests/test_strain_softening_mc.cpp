@@ -1,4 +1,4 @@
-// Unit tests of the strain_softening_mc material at one material point (VERIFICATION.md
+// Unit tests of the strain_softening_mc material at one material point (docs/verification.md
 // section B), driven directly through MaterialBatch, and its parameter checks through the
 // command line. Formulas here use compression positive (sigma'_1 >= sigma'_3), the material
 // tension positive.
@@ -108,7 +108,7 @@ TEST_CASE("strain_softening_mc: drained triaxial shows the peak then the residua
           "[material][unit]") {
   // Reference: sigma_1,f = sigma_3 (1 + sin phi)/(1 - sin phi) + 2 c cos phi/(1 - sin phi),
   // with the peak parameters at the peak and the residual ones once plastic_strain_eq >=
-  // softening_end. Tolerance 0.5% (VERIFICATION.md B); the return is exact, so round-off is
+  // softening_end. Tolerance 0.5% (docs/verification.md B); the return is exact, so round-off is
   // expected. softening_start 0.01 (a peak plateau) and 0 (the default: peak at first yield).
   for (double start : {0.01, 0.0}) {
     Soft m;
@@ -153,7 +153,7 @@ TEST_CASE("strain_softening_mc: element-test driver triaxial peak and residual",
   // The same check through loam::run_element_test (triaxial_drained, sigma'_3 = 200 kPa, 15%
   // axial strain in 1500 increments): sigma'_1 = q + sigma'_3 peaks at the MC formula with the
   // peak parameters and ends at the one with the residual parameters, within 0.5%
-  // (VERIFICATION.md B; round-off expected).
+  // (docs/verification.md B; round-off expected).
   Soft m;
   loam::ElementTest t;
   t.path = "triaxial_drained";

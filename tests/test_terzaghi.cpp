@@ -1,5 +1,5 @@
 // Terzaghi one-way consolidation (plugins/terzaghi.hpp series, plugins/terzaghi.cpp reference;
-// VERIFICATION.md C). The series are checked against classic tables (U(T) and T(U)), a sum
+// docs/verification.md C). The series are checked against classic tables (U(T) and T(U)), a sum
 // written out here, closed forms, their own limits and boundary conditions, each other, and the
 // two-way layer that tests/test_hydraulic_boundaries.cpp maps onto them; the reference plugin is
 // checked by filling the pore_pressure field with known values (no two-phase scheme exists yet) and

@@ -1,5 +1,5 @@
 // The two_phase_single_point scheme (schemes/two_phase_single_point.cpp) against Terzaghi's
-// consolidation (VERIFICATION.md C, seed 001 small strain), through the real CLI, and its
+// consolidation (docs/verification.md C, seed 001 small strain), through the real CLI, and its
 // set-up errors.
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -12,7 +12,7 @@
 namespace {
 
 void check_terzaghi(const std::string& config, const std::string& extra = "") {
-  // Reference: VERIFICATION.md C, p(z,t)/p0 series with c_v = k M / gamma_w = 1.0194 m^2/s,
+  // Reference: docs/verification.md C, p(z,t)/p0 series with c_v = k M / gamma_w = 1.0194 m^2/s,
   // one-way drainage, H = 1 m. Target (issue 6): max |p/p0 - exact| <= 0.02 at each T, the
   // degree of consolidation within 0.01.
   loam_test::TempDir dir("terzaghi");

@@ -1,4 +1,4 @@
-// Regression scenes run through the real CLI against VERIFICATION.md section A.
+// Regression scenes run through the real CLI against docs/verification.md section A.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
@@ -10,7 +10,7 @@
 using loam_test::run_scene;
 using loam_test::TempDir;
 
-TEST_CASE("vibrating bar: period and energy over 10 periods (VERIFICATION.md A)",
+TEST_CASE("vibrating bar: period and energy over 10 periods (docs/verification.md A)",
           "[verification]") {
   // Reference: T = 4L/c = 10 s for L = 25 m, E = 100 Pa, rho = 1; MUSL, linear shape functions.
   // Tolerances from issue 3: period error < 1 %, total-energy drift < 1 % over 10 periods.
@@ -41,7 +41,7 @@ TEST_CASE("vibrating bar under USL and USF also keeps its period", "[verificatio
   }
 }
 
-TEST_CASE("elastic column 1D/2D/3D: stress vs rho g (H - z) (VERIFICATION.md A)",
+TEST_CASE("elastic column 1D/2D/3D: stress vs rho g (H - z) (docs/verification.md A)",
           "[verification]") {
   // Tolerance from issue 3: relative L2 error of sigma_v < 3 %; 2D and 3D agree with 1D within 1 %.
   std::vector<nlohmann::json> v;

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Seed 002 dynamic consolidation (VERIFICATION.md C; seed paper Figs. 5 and 6): pore pressure
+"""Seed 002 dynamic consolidation (docs/verification.md C; seed paper Figs. 5 and 6): pore pressure
 p/p0 against depth at the requested times for a fixed-base and an absorbing-base run, beside
 Terzaghi's series at each frame's own time, and the pore pressure of the deepest particle
 against time for both runs (probe_base.csv).

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Plot normalised pore pressure p/p0 against depth from a two-phase run's particle frames, at
 the frames nearest to the requested time factors T = c_v t / H^2, beside Terzaghi's series
-(VERIFICATION.md C) evaluated at each frame's own time.
+(docs/verification.md C) evaluated at each frame's own time.
 Usage: terzaghi_plot.py RUN_DIR --cv 1.0194 --H 1 --p0 1e4 [--T 0.05 0.1 0.2 0.5 1] --out x.png
 The vertical axis is the last coordinate; depth is measured from the initial top of the column."""
 import argparse
