@@ -199,6 +199,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       sim.timed("grid", [&] { integrate(sim, dt); });
       for (auto& s : scratch_) s->max_v2 = 0;
       if (musl_) {
+        move_.resize(sim.particles.size() * D);
         sim.timed("grid", [&] { std::fill(remap_.begin(), remap_.end(), 0.0); });
         sim.timed("g2p_velocity_remap", [&] {
           sim.scatter_blocks([&](size_t b, int c, int t) { remap<NPP>(sim, dt, b, c, t); });
@@ -240,7 +241,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   std::vector<double> remap_;  // MUSL: per node solid then water velocity (2 D values)
   int w_ = -1, n_ = -1, p_ = -1, F_ = -1;
   std::vector<double> node_;
-  std::vector<double> solved_;            // per node: v', w' of the coupled solve (2 D values)
+  std::vector<double> solved_;  // per node: v', w' of the coupled solve (2 D values)
+  std::vector<double> move_;    // MUSL: per particle, dt v_grid from the re-map pass (D values)
   std::vector<double> mixture_momentum_;  // per node (D values), only with damping
   // Pore-pressure increments of the step and, per grid cell, the volume-weighted sum of the
   // updated pressures and the volume (pressure_smoothing: cell).
@@ -508,7 +510,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     double max_v2 = sc.max_v2;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      max_v2 = std::max(max_v2, velocity_update<false>(P, st, p, i, npp, dt));
+      max_v2 = std::max(max_v2, velocity_update<false>(P, st, p, i, npp, dt, &move_[i * D]));
       const double ms = P.col(P.mass)[i], mw = P.col(n_)[i] * rho_w_ * P.col(P.volume)[i];
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -539,11 +541,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     sim.constrain(NodalVector{remap_.data(), 2 * D, D}, 1);
   }
 
-  /// Particle p (index i) of a block: FLIP/PIC update of v and w from the grid record and, with
-  /// MOVE, its move with the solid grid velocity; returns |v|^2.
+  /// Particle p (index i) of a block: FLIP/PIC update of v and w from the grid record and its
+  /// move dt v_grid with the solid grid velocity: done now with MOVE, else stored in `move`
+  /// (D values) for the gradient pass; returns |v|^2.
   template <bool MOVE>
   double velocity_update(Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
-                         double dt) {
+                         double dt, double* move = nullptr) {
     double vn[D] = {}, wn[D] = {}, as[D] = {}, aw[D] = {};
     for (int k = 0; k < npp; ++k) {
       const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -562,7 +565,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       double& w = P.col(w_, d)[i];
       v = flip_ * (v + dt * as[d]) + (1 - flip_) * vn[d];
       w = flip_ * (w + dt * aw[d]) + (1 - flip_) * wn[d];
-      if constexpr (MOVE) P.col(P.position, d)[i] += dt * vn[d];
+      if constexpr (MOVE)
+        P.col(P.position, d)[i] += dt * vn[d];
+      else
+        move[d] = dt * vn[d];
       v2 += v * v;
     }
     return v2;
@@ -587,15 +593,13 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       // (the stencil was evaluated at x^n above, so moving here does not change it).
       if constexpr (!REMAPPED)
         max_v2 = std::max(max_v2, velocity_update<true>(P, st, p, i, npp, dt));
-      double ls[D][D] = {}, lw[D][D] = {}, vn[D] = {};
+      double ls[D][D] = {}, lw[D][D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double* r = g + size_t(st.node[kp]) * S;
         // Velocities whose gradients are taken: re-mapped (MUSL) or updated grid ones (USL).
         const double* vs = REMAPPED ? remap_.data() + size_t(st.node[kp]) * 2 * D : r + kV;
         const double* vw = REMAPPED ? vs + D : r + kW;
-        if constexpr (REMAPPED)
-          for (int d = 0; d < D; ++d) vn[d] += st.w[kp] * r[kV + d];
         for (int j = 0; j < D; ++j) {
           const double gj = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
           for (int d = 0; d < D; ++d) {
@@ -606,7 +610,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       }
       // MUSL: move with the updated solid grid velocity, after L on the start-of-step stencil.
       if constexpr (REMAPPED)
-        for (int d = 0; d < D; ++d) P.col(P.position, d)[i] += dt * vn[d];
+        for (int d = 0; d < D; ++d) P.col(P.position, d)[i] += move_[i * D + size_t(d)];
       double trs = 0, trw = 0;
       for (int d = 0; d < D; ++d) {
         trs += ls[d][d];
