@@ -393,19 +393,24 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// (-n grad p: the nodal porosity times the weak form of -grad p, not of -grad(n p), which
   /// would add a spurious -p grad n where n varies).
   void water_force_and_porosity(Simulation<D>& sim) {
-    const long nn = long(sim.grid.num_nodes);
     const double tol = sim.mass_tolerance;
-    double* g = node_.data();
-#pragma omp parallel for schedule(static) num_threads(sim.threads)
-    for (long i = 0; i < nn; ++i) {
-      double* r = g + size_t(i) * S;
+    for_each_node(sim, [&](double* r, size_t) {
       if (r[kMs] <= tol) {
         r[kN] = 0.0;
-        continue;
+        return;
       }
       r[kN] = r[kN] > 0 ? r[kMw] / (rho_w_ * r[kN]) : 0.0;
       for (int d = 0; d < D; ++d) r[kFw + d] = r[kN] * r[kFw + d] + r[kMw] * sim.gravity[size_t(d)];
-    }
+    });
+  }
+
+  /// f(record, node) for every grid node, in parallel (static schedule).
+  template <class F>
+  void for_each_node(const Simulation<D>& sim, F&& f) {
+    const long nn = long(sim.grid.num_nodes);
+    double* g = node_.data();
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+    for (long i = 0; i < nn; ++i) f(g + size_t(i) * S, size_t(i));
   }
 
   /// Local damping (damping:) acts on the mixture's momentum balance: the net nodal force of
@@ -414,13 +419,9 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// would slow steady seepage (where the water force balances the drag, not zero) by (1 - alpha).
   void damp_mixture(Simulation<D>& sim) {
     if (!sim.damping) return;
-    const long nn = long(sim.grid.num_nodes);
-    const double* g = node_.data();
-#pragma omp parallel for schedule(static) num_threads(sim.threads)
-    for (long i = 0; i < nn; ++i)
-      for (int d = 0; d < D; ++d)
-        mixture_momentum_[size_t(i) * D + size_t(d)] =
-            g[size_t(i) * S + kV + size_t(d)] + g[size_t(i) * S + kW + size_t(d)];
+    for_each_node(sim, [&](const double* r, size_t i) {
+      for (int d = 0; d < D; ++d) mixture_momentum_[i * D + size_t(d)] = r[kV + d] + r[kW + d];
+    });
     sim.apply_damping(NodeForces{node_.data() + kMs, NodalVector{mixture_momentum_.data(), D, 0},
                                  NodalVector{node_.data(), S, kF}, sim.grid.num_nodes, S});
   }
@@ -431,18 +432,14 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// The record then holds the new velocities and the accelerations (v' - v)/dt, (w' - w)/dt;
   /// solved_ keeps the velocities of the solve for follow_held_phase().
   void solve_coupled(Simulation<D>& sim, double dt) {
-    const long nn = long(sim.grid.num_nodes);
     const double tol = sim.mass_tolerance;
-    double* g = node_.data();
-#pragma omp parallel for schedule(static) num_threads(sim.threads)
-    for (long i = 0; i < nn; ++i) {
-      double* r = g + size_t(i) * S;
-      double* solved = solved_.data() + size_t(i) * 2 * D;
+    for_each_node(sim, [&](double* r, size_t i) {
+      double* solved = solved_.data() + i * 2 * D;
       const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
       if (ms <= tol) {
         for (int c = kV; c < S; ++c) r[c] = 0.0;
         for (int c = 0; c < 2 * D; ++c) solved[c] = 0.0;
-        continue;
+        return;
       }
       for (int d = 0; d < D; ++d) {
         const double v = r[kV + d] / ms, w = mw > tol ? r[kW + d] / mw : v;
@@ -457,7 +454,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         r[kF + d] = (vn - v) / dt;
         r[kFw + d] = (wn - w) / dt;
       }
-    }
+    });
   }
 
   /// A condition that holds one phase of a node component and leaves the other free (a fixed
@@ -470,15 +467,11 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// velocity of the solve (over-drainage near the face). A component whose phases both changed
   /// (both held, tied by impermeable, damped by a dashpot) is left as its conditions set it.
   void follow_held_phase(Simulation<D>& sim, double dt) {
-    const long nn = long(sim.grid.num_nodes);
     const double tol = sim.mass_tolerance;
-    double* g = node_.data();
-#pragma omp parallel for schedule(static) num_threads(sim.threads)
-    for (long i = 0; i < nn; ++i) {
-      double* r = g + size_t(i) * S;
-      const double* solved = solved_.data() + size_t(i) * 2 * D;
+    for_each_node(sim, [&](double* r, size_t i) {
+      const double* solved = solved_.data() + i * 2 * D;
       const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
-      if (ms <= tol || mw <= tol || !(Q > 0)) continue;
+      if (ms <= tol || mw <= tol || !(Q > 0)) return;
       for (int d = 0; d < D; ++d) {
         const double dv = r[kV + d] - solved[d], dw = r[kW + d] - solved[D + d];
         if (dv != 0.0 && dw == 0.0) {
@@ -491,7 +484,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
           r[kF + d] += c / dt;
         }
       }
-    }
+    });
   }
 
   /// MUSL first pass: FLIP/PIC update of both particle velocities and the scatter of their new

@@ -4,7 +4,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -24,6 +26,26 @@ inline CliResult run_loam(const std::string& args) {
   int status = pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+/// Columns of a CSV file written by loam (probe_*.csv, history.csv) by header name; empty if the
+/// file does not exist.
+inline std::map<std::string, std::vector<double>> read_csv_columns(
+    const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  std::stringstream hs(line);
+  for (std::string c; std::getline(hs, c, ',');) names.push_back(c);
+  std::map<std::string, std::vector<double>> cols;
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    std::string c;
+    for (size_t k = 0; k < names.size() && std::getline(ls, c, ','); ++k)
+      cols[names[k]].push_back(std::stod(c));
+  }
+  return cols;
 }
 
 /// A fresh, empty directory under the system temp dir, removed when the object dies.

@@ -20,24 +20,6 @@
 
 namespace {
 
-/// Columns of a CSV file written by loam (probe_*.csv, history.csv) by header name.
-std::map<std::string, std::vector<double>> read_csv(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> names;
-  std::stringstream hs(line);
-  for (std::string c; std::getline(hs, c, ',');) names.push_back(c);
-  std::map<std::string, std::vector<double>> cols;
-  while (std::getline(in, line)) {
-    std::stringstream ls(line);
-    std::string c;
-    for (size_t k = 0; k < names.size() && std::getline(ls, c, ','); ++k)
-      cols[names[k]].push_back(std::stod(c));
-  }
-  return cols;
-}
-
 // ------------------------------------------------------------------ nodal update, hand values
 
 /// Run the absorbing plugin of a D-dimensional scene on a hand-made grid update and compare
@@ -177,8 +159,8 @@ Reflection pulse(int D, const std::string& face_bc, const std::string& extra) {
   auto r = loam_test::run_loam("run " + cfg.string() + " --quiet --threads 1 --out " +
                                (dir.path / "out").string() + " " + extra);
   REQUIRE(r.exit_code == 0);
-  auto probe = read_csv(dir.path / "out" / "probe_mid.csv");
-  auto hist = read_csv(dir.path / "out" / "history.csv");
+  auto probe = loam_test::read_csv_columns(dir.path / "out" / "probe_mid.csv");
+  auto hist = loam_test::read_csv_columns(dir.path / "out" / "history.csv");
   Reflection out;
   const auto& t = probe["time"];
   const auto& s = probe["stress_xx"];
@@ -238,7 +220,7 @@ std::vector<double> column_probe(const std::string& config, double height, doubl
                 "--set output.every_time=1",
                 height - 0.5, height, height, kappa);
   loam_test::run_scene(config, dir.path, set);
-  return read_csv(dir.path / "probe_base.csv")["pore_pressure"];
+  return loam_test::read_csv_columns(dir.path / "probe_base.csv")["pore_pressure"];
 }
 
 /// Reflection coefficient: max |p - p_ref| / max |p_ref| over the window, with p_ref from a 2 m

@@ -582,6 +582,21 @@ namespace {
 const char* const kAllShapes[] = {"linear", "gimp", "{type: gimp, domain_update: stretch}", "cpdi",
                                   "bspline2"};
 
+/// run(std::integral_constant<int, D>, shape, deformed) for every shape function in 1D, 2D and 3D,
+/// and again with deformed domains for those whose domains deform (gimp stretch, cpdi).
+template <class Run>
+void for_every_shape(const Run& run) {
+  for (std::string shape : kAllShapes) {
+    INFO(shape);
+    for (bool deformed : {false, true}) {
+      if (deformed && shape.find("stretch") == std::string::npos && shape != "cpdi") continue;
+      run(std::integral_constant<int, 1>{}, shape, deformed);
+      run(std::integral_constant<int, 2>{}, shape, deformed);
+      run(std::integral_constant<int, 3>{}, shape, deformed);
+    }
+  }
+}
+
 /// Give the particles of `sim` deformed domains: GIMP stretch diagonal F_dd in [0.3, 4] (lp from
 /// 0.075 h to h, capped), CPDI a general F (stretch, shear, rotation; det F > 0.2); then let
 /// begin_step turn F into the domains. CPDI's own corner-outside-the-grid check would stop a run
@@ -672,15 +687,7 @@ TEST_CASE(
     CHECK(e.rows == 0);
     CHECK(e.nonfinite == 0);
   };
-  for (std::string shape : kAllShapes) {
-    INFO(shape);
-    for (bool deformed : {false, true}) {
-      if (deformed && shape.find("stretch") == std::string::npos && shape != "cpdi") continue;
-      run(std::integral_constant<int, 1>{}, shape, deformed);
-      run(std::integral_constant<int, 2>{}, shape, deformed);
-      run(std::integral_constant<int, 3>{}, shape, deformed);
-    }
-  }
+  for_every_shape(run);
 }
 
 TEST_CASE("every shape function: a particle on a grid face is carried by the face nodes alone",
@@ -734,15 +741,7 @@ TEST_CASE("every shape function: a particle on a grid face is carried by the fac
     CHECK(worst_sum < 1e-14);
     if (!(deformed && shape == "cpdi")) CHECK(worst_abs < 1e-14);
   };
-  for (std::string shape : kAllShapes) {
-    INFO(shape);
-    for (bool deformed : {false, true}) {
-      if (deformed && shape.find("stretch") == std::string::npos && shape != "cpdi") continue;
-      run(std::integral_constant<int, 1>{}, shape, deformed);
-      run(std::integral_constant<int, 2>{}, shape, deformed);
-      run(std::integral_constant<int, 3>{}, shape, deformed);
-    }
-  }
+  for_every_shape(run);
 }
 
 TEST_CASE("vibrating bar with gimp and bspline2 through the CLI: period and energy",

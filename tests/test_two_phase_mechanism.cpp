@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -24,21 +25,13 @@ std::string read_config(const std::string& name) {
   return s.str();
 }
 
-/// A run of `yaml` through the CLI with `extra` arguments: exit code, summary and history.csv
-/// (columns by name).
+/// A run of `yaml` through the CLI with `extra` arguments: exit code, summary and history.csv.
 struct CliRun {
   int exit_code = -1;
   std::string output;
   nlohmann::json summary;
-  std::vector<std::string> columns;
-  std::vector<std::vector<double>> history;
-  std::vector<double> column(const std::string& name) const {
-    std::vector<double> v;
-    for (size_t c = 0; c < columns.size(); ++c)
-      if (columns[c] == name)
-        for (const auto& row : history) v.push_back(row[c]);
-    return v;
-  }
+  std::map<std::string, std::vector<double>> history;
+  const std::vector<double>& column(const std::string& name) { return history[name]; }
 };
 
 CliRun run_yaml(const std::string& yaml, const std::string& extra) {
@@ -53,18 +46,7 @@ CliRun run_yaml(const std::string& yaml, const std::string& extra) {
   run.output = r.output;
   std::ifstream js(dir.path / "out" / "summary.json");
   if (js) run.summary = nlohmann::json::parse(js);
-  std::ifstream csv(dir.path / "out" / "history.csv");
-  std::string line, cell;
-  if (std::getline(csv, line)) {
-    std::stringstream hs(line);
-    while (std::getline(hs, cell, ',')) run.columns.push_back(cell);
-  }
-  while (std::getline(csv, line)) {
-    std::stringstream ls(line);
-    std::vector<double> row;
-    while (std::getline(ls, cell, ',')) row.push_back(std::stod(cell));
-    run.history.push_back(row);
-  }
+  run.history = loam_test::read_csv_columns(dir.path / "out" / "history.csv");
   return run;
 }
 

@@ -21,24 +21,6 @@
 
 namespace {
 
-/// Columns of a CSV file written by loam (probe_*.csv) by header name.
-std::map<std::string, std::vector<double>> read_csv(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> names;
-  std::stringstream hs(line);
-  for (std::string c; std::getline(hs, c, ',');) names.push_back(c);
-  std::map<std::string, std::vector<double>> cols;
-  while (std::getline(in, line)) {
-    std::stringstream ls(line);
-    std::string c;
-    for (size_t k = 0; k < names.size() && std::getline(ls, c, ','); ++k)
-      cols[names[k]].push_back(std::stod(c));
-  }
-  return cols;
-}
-
 constexpr double kRho = 1000, kG = 9.81, kH = 0.2, kEnd = 0.3;
 
 /// The tank: a `width` x 0.4 m grid of cell h, a 0.1 x 0.2 m column of water (newtonian_fluid,
@@ -86,7 +68,8 @@ Tank run_tank(const std::string& name, double width, double h, const std::string
   t.exit_code = r.exit_code;
   t.output = r.output;
   for (size_t k = 0; k < std::size(kProbeX); ++k)
-    t.bottom.push_back(read_csv(dir.path / "out" / ("probe_b" + std::to_string(k) + ".csv")));
+    t.bottom.push_back(
+        loam_test::read_csv_columns(dir.path / "out" / ("probe_b" + std::to_string(k) + ".csv")));
   return t;
 }
 
