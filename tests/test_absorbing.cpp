@@ -1,4 +1,4 @@
-// The viscous absorbing boundary (plugins/absorbing.cpp, Lysmer & Kuhlemeyer 1969): its nodal
+// The viscous absorbing boundary (plugins/boundaries/absorbing.cpp, Lysmer & Kuhlemeyer 1969): its nodal
 // update against hand values (tributary areas, implicit dashpot, the two-phase impermeable
 // form), the reflection of a 1D/2D elastic pulse (single_phase) and of the undrained wave in a
 // saturated column (two_phase_single_point) against the same scenes with a fixed face, and its
@@ -92,7 +92,7 @@ void check_nodal_update(const std::string& yaml, int axis, const std::vector<dou
 
 TEST_CASE("absorbing: implicit dashpots with tributary face areas, hand values",
           "[boundary][unit]") {
-  // Reference: the plugin's equations (plugins/absorbing.cpp header): v = m v*/(m + dt rho c A)
+  // Reference: the plugin's equations (plugins/boundaries/absorbing.cpp header): v = m v*/(m + dt rho c A)
   // per component (c_p normal, c_s tangential), a += (v - v*)/dt; two phases: common normal
   // velocity (m_s v_s* + m_w v_w*)/(m_s + m_w + dt rho c_p A), water tangential untouched. A:
   // 1 in 1D; h or h/2 (grid edge) in 2D; h1 h2, /2 on an edge, /4 at a corner in 3D. Nodes off

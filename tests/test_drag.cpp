@@ -1,4 +1,4 @@
-// Drag laws (plugins/darcy.cpp, plugins/ergun.cpp) against hand-computed values
+// Drag laws (plugins/drag/darcy.cpp, plugins/drag/ergun.cpp) against hand-computed values
 // (docs/verification.md D). Convention (framework/drag.hpp): Q is per unit MIXTURE volume, the
 // force on the water is -Q (w - v), and Darcy's law q = n (w - v) = -(k/gamma_w) grad p gives Q =
 // n^2 gamma_w / k = n^2 mu_w / kappa. Seed 001's coefficient per unit WATER volume, n gamma_w / k,

@@ -1,4 +1,4 @@
-// Coulomb friction where a friction face meets other faces (plugins/friction.cpp, the passes of
+// Coulomb friction where a friction face meets other faces (plugins/boundaries/friction.cpp, the passes of
 // Simulation::constrain_update): every normal/kinematic constraint first, then each friction
 // face's impulse mu |v_n| (v_n before any constraint) in the tangential components no condition
 // holds (Bardenhagen, Brackbill & Sulsky 2000). The result must not depend on the order of the
@@ -86,7 +86,7 @@ double max_difference(const Nodes& a, const Nodes& b) {
 
 TEST_CASE("friction edges: a friction base and a slip wall give the Coulomb answer in both orders",
           "[boundary][unit]") {
-  // Reference (hand values, plugins/friction.cpp): edge node of the friction base y- (mu = 1)
+  // Reference (hand values, plugins/boundaries/friction.cpp): edge node of the friction base y- (mu = 1)
   // and the slip wall x-, v* = (-1, -0.5, 1), dt = 0.01, a* = (5, 6, 7). The wall holds v_x,
   // the base v_y (into it: budget mu |v_n| = 0.5); the free tangential speed |v_z| = 1 drops by
   // 0.5: v = (0, 0, 0.5). The wall zeroes a_x; friction adds (v - v*)/dt: a_y = 6 + 50,

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "framework/registry.hpp"
@@ -69,4 +70,32 @@ TEST_CASE("test names contain no semicolon (ctest would split them and run nothi
     }
   }
   CHECK(cases > 20);
+}
+
+TEST_CASE("every built-in plugin is one file named as its YAML type, in its kind's folder",
+          "[layout]") {
+  // One concept per file, grouped by kind (README "Layout"): materials/, shapefunctions/,
+  // schemes/, plugins/<kind>/. A plugin registered by the test binary itself or loaded from a
+  // library is not built-in and is skipped.
+  const std::map<std::string, std::string> folder = {
+      {"material", "materials"},          {"shape_function", "shapefunctions"},
+      {"scheme", "schemes"},              {"boundary", "plugins/boundaries"},
+      {"load", "plugins/loads"},          {"damping", "plugins/damping"},
+      {"drag", "plugins/drag"},           {"generator", "plugins/generators"},
+      {"field", "plugins/fields"},        {"reference", "plugins/references"},
+      {"writer", "plugins/writers"}};
+  auto& reg = loam::Registry::instance();
+  int checked = 0;
+  for (const auto& k : reg.kinds()) {
+    INFO("kind " << k.name);
+    REQUIRE(folder.count(k.name) == 1);
+    for (const auto& n : reg.names(k.name)) {
+      if (reg.find(k.name, n)->origin != "built-in") continue;
+      const fs::path file = fs::path(LOAM_SOURCE_DIR) / folder.at(k.name) / (n + ".cpp");
+      INFO(file.string());
+      CHECK(fs::exists(file));
+      ++checked;
+    }
+  }
+  CHECK(checked >= 30);
 }

@@ -1,4 +1,4 @@
-// Terzaghi one-way consolidation (plugins/terzaghi.hpp series, plugins/terzaghi.cpp reference;
+// Terzaghi one-way consolidation (plugins/references/terzaghi.hpp series, plugins/references/terzaghi.cpp reference;
 // docs/verification.md C). The series are checked against classic tables (U(T) and T(U)), a sum
 // written out here, closed forms, their own limits and boundary conditions, each other, and the
 // two-way layer that tests/test_hydraulic_boundaries.cpp maps onto them; the reference plugin is
@@ -17,7 +17,7 @@
 #include "cli.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
-#include "plugins/terzaghi.hpp"
+#include "plugins/references/terzaghi.hpp"
 #include "sim_helpers.hpp"
 
 using loam::terzaghi_degree;
@@ -57,7 +57,7 @@ TEST_CASE("terzaghi: small time factors follow U = 2 sqrt(T/pi)", "[reference][u
 }
 
 TEST_CASE("terzaghi: the Fourier and image series agree", "[reference][unit]") {
-  // Reference: two independent forms of the same solution (plugins/terzaghi.hpp). Where both
+  // Reference: two independent forms of the same solution (plugins/references/terzaghi.hpp). Where both
   // converge (1e-4 <= T <= 2) they must agree. Tolerance: 1e-13 absolute on p/p0 and U.
   double worst_p = 0, worst_u = 0;
   int most_f = 0, most_i = 0;
@@ -136,7 +136,7 @@ TEST_CASE("terzaghi: U equals one minus the mean pore pressure", "[reference][un
 
 namespace {
 
-/// Terzaghi's one-way series written out here, independently of plugins/terzaghi.hpp:
+/// Terzaghi's one-way series written out here, independently of plugins/references/terzaghi.hpp:
 /// p/p0 = sum_{m>=0} (2/M) sin(M z'/H) exp(-M^2 T), M = (2m+1) pi/2, z' down from the drained
 /// top, summed over a fixed 20000 terms (at T >= 0.005 the last term is below 1e-300: the
 /// truncation is nil, the rounding ~1e-15).

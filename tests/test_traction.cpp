@@ -1,4 +1,4 @@
-// The traction load's surface point (plugins/traction.cpp, apply_at: surface) under shear and
+// The traction load's surface point (plugins/loads/traction.cpp, apply_at: surface) under shear and
 // rotation: the load must act at the centre of the particle's loaded face convected with its
 // deformation gradient, x_s = x_p + F (s/2) N (issue 11.8; the same convection as CPDI's domain
 // corners). The nodal forces are t A N_I(x_s) with the grid's tent functions, so their sum is

@@ -19,7 +19,7 @@
 #include <cmath>
 
 #include "framework/registry.hpp"
-#include "plugins/column.hpp"
+#include "plugins/references/column.hpp"
 
 namespace loam {
 

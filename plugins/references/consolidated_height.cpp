@@ -15,7 +15,7 @@
 #include <limits>
 
 #include "framework/registry.hpp"
-#include "plugins/column.hpp"
+#include "plugins/references/column.hpp"
 
 namespace loam {
 

@@ -1,5 +1,5 @@
 // Reference: Terzaghi one-dimensional consolidation with one-way drainage (docs/verification.md C;
-// series in plugins/terzaghi.hpp). The column is a body whose top face (the last axis, upward)
+// series in plugins/references/terzaghi.hpp). The column is a body whose top face (the last axis, upward)
 // is drained and whose base is impermeable; its excess pore pressure starts at p0 = `load`.
 //
 // It reads the particle field `pore_pressure` (compression positive, Pa), which a two-phase
@@ -17,7 +17,7 @@
 // consolidation_degree_error (worst over T; NaN if some T was never reached), drainage_length.
 // Gravity: the exact solution is for the EXCESS pore pressure; a run with hydrostatic pore
 // pressure needs a scheme that stores the excess or a reference option (not yet provided).
-#include "plugins/terzaghi.hpp"
+#include "plugins/references/terzaghi.hpp"
 
 #include <algorithm>
 #include <cmath>
