@@ -40,7 +40,7 @@ const MaterialCase kCases[] = {
 
 /// Nanoseconds per particle update over `steps` steps of the velocity gradient L (3x3, dt = 1).
 double time_updates(Simulation<3>& sim, const double (&L)[3][3], int steps) {
-  auto& P = sim.particles;
+  auto& P = sim.sets[0].particles;
   std::vector<double> Lb(9 * kBlock);
   for (int k = 0; k < 9; ++k)
     for (int p = 0; p < kBlock; ++p) Lb[size_t(k) * kBlock + size_t(p)] = L[k / 3][k % 3];
@@ -80,7 +80,7 @@ int run_material_bench(const BenchOptions& opt) {
     std::vector<double> elastic, plastic;
     for (int r = 0; r < opt.repeat; ++r) {
       Simulation<3> sim(cfg.params, 1, diag);
-      auto& P = sim.particles;
+      auto& P = sim.sets[0].particles;
       for (int k = 0; k < 6; ++k)
         for (size_t i = 0; i < P.size(); ++i) P.col(P.stress, k)[i] = k < 3 ? -100e3 : 0.0;
       sim.materials[0]->initialize(P, 0, P.size());

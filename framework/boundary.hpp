@@ -124,8 +124,9 @@ class Boundary {
   /// Hydraulic conditions (drained, impermeable, prescribed pore pressure) act on the water
   /// after every mechanical condition, whatever the order of the config.
   virtual bool hydraulic() const { return false; }
-  /// Called on every condition before any condition acts on the grid update: record the unconstrained state the condition needs
-  /// (the water's update to release it on a drained face, a friction face's normal velocity).
+  /// Called on every condition before any condition acts on the grid update: record the
+  /// unconstrained state the condition needs (the water's update to release it on a drained face, a
+  /// friction face's normal velocity).
   virtual void before_constraints(const GridUpdate&) {}
   /// The same before the conditions act on a single nodal vector of `phase`.
   virtual void before_constrain(const NodalVector& /*v*/, int /*phase*/) {}

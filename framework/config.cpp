@@ -37,8 +37,13 @@ Schema config_schema() {
   s.vector("gravity", "m/s^2", "gravitational acceleration").def("0").scalar_ok();
   {
     Schema b;
-    b.text("name", "body name, used by loads, particle sets and output").required();
-    b.plugin("generator", "generator", "region filled with particles").required();
+    b.text("name", "body name, used by loads, references and output").required();
+    b.text("set",
+           "the particle set of the scheme the body's particles belong to (default: the "
+           "scheme's first set; `loam plugins` lists each scheme's sets)");
+    b.plugin("generator", "generator",
+             "region filled with particles at t = 0 (none: the body starts empty and gets its "
+             "particles from a source)");
     b.integer("particles_per_cell", "particles per cell along each axis").def("2").min(1).max(10);
     b.plugin("material", "material", "constitutive model of the body").required();
     b.plugin("velocity", "field", "initial velocity (a list is a constant)").components(kDimension);
@@ -61,13 +66,15 @@ Schema config_schema() {
   }
   {
     Schema ps;
-    ps.text("name", "set name, referred to by loads").required();
+    ps.text("name", "selection name, referred to by loads (traction `selection:`)").required();
     ps.vector("min", "m", "lower corner of the selection box").required();
     ps.vector("max", "m", "upper corner of the selection box").required();
-    s.section_list("particle_sets", ps, "named sets of particles (box selections at t = 0)");
+    s.section_list("selections", ps, "named selections of particles (boxes, at t = 0)");
   }
   s.plugin_list("boundaries", "boundary", "boundary conditions on grid faces");
   s.plugin_list("loads", "load", "external loads");
+  s.plugin_list("sources", "source", "particle sources: inflow of a body's particles");
+  s.plugin_list("sinks", "sink", "particle sinks: outflow, removing particles");
   s.plugin("damping", "damping", "numerical damping (e.g. to reach a static state)");
   {
     Schema t;
@@ -111,6 +118,7 @@ Schema config_schema() {
     Schema p;
     p.text("name", "probe name; written to probe_<name>.csv").required();
     p.vector("particle_near", "m", "follow the particle nearest to this point at t = 0");
+    p.text("set", "with particle_near: the particle set to search (default: the scheme's first)");
     p.vector("node", "-", "grid node indices (i, j, k)");
     p.string_list("fields", "fields to record").def("[position, velocity]");
     p.integer("every_steps", "sample every N steps").def("1").min(1);

@@ -1,6 +1,6 @@
 #pragma once
 // Collects every configuration error before any work starts, each formatted as
-// FILE:LINE:COL: error: key.path: message   (DESIGN.md "Input and errors").
+// FILE:LINE:COL: error: key.path: message   (docs/architecture.md "Errors").
 #include <string>
 #include <vector>
 

@@ -93,7 +93,7 @@ class Point {
     sim_ = std::make_unique<Simulation<3>>(cfg.params, 1, diag);
     if (!diag.ok()) throw std::logic_error("element test: " + diag.format());
     sim_->materials[0] = Registry::instance().create<Material, 3>(material);
-    auto& P = sim_->particles;
+    auto& P = sim_->sets[0].particles;
     // The mass follows the tested material's density (density-dependent models read m / V).
     P.col(P.mass)[0] = P.col(P.volume)[0] * sim_->materials[0]->density();
     sim_->materials[0]->setup(*sim_, 0, diag);
@@ -107,16 +107,18 @@ class Point {
     batch_.particles = &P;
   }
 
-  Particles<3>& particles() { return sim_->particles; }
-  double stress(int c) const { return sim_->particles.col(sim_->particles.stress, c)[0]; }
+  Particles<3>& particles() { return sim_->sets[0].particles; }
+  double stress(int c) const {
+    return sim_->sets[0].particles.col(sim_->sets[0].particles.stress, c)[0];
+  }
 
   /// Every field value of the particle, to retry an increment from the same state.
-  std::vector<double> save() const { return sim_->particles.state_of(0); }
-  void restore(const std::vector<double>& s) { sim_->particles.restore_state(0, s); }
+  std::vector<double> save() const { return sim_->sets[0].particles.state_of(0); }
+  void restore(const std::vector<double>& s) { sim_->sets[0].particles.restore_state(0, s); }
 
   /// One step as a scheme does it: V *= det(I + L dt), then the material's stress update.
   void step(const Mat3& L, double dt) {
-    auto& P = sim_->particles;
+    auto& P = sim_->sets[0].particles;
     Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {

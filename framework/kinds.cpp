@@ -9,6 +9,8 @@ LOAM_REGISTER_KIND("drag",
 LOAM_REGISTER_KIND("boundary", "constraints on grid-face nodes")
 LOAM_REGISTER_KIND("load", "external forces on particles or nodes")
 LOAM_REGISTER_KIND("damping", "numerical damping of nodal forces")
+LOAM_REGISTER_KIND("source", "particles created while the run goes (inflow)")
+LOAM_REGISTER_KIND("sink", "particles removed while the run goes (outflow)")
 LOAM_REGISTER_KIND("generator", "regions filled with particles")
 LOAM_REGISTER_KIND("field", "spatial fields for initial conditions (a list is a constant)")
 LOAM_REGISTER_KIND("reference", "analytic references for `verify:`, with error metrics")

@@ -31,6 +31,9 @@ struct FieldInfo {
   std::string unit;
   std::string doc;
   std::vector<std::string> component_names;  // for output ("x", "y", "xx", ...)
+  /// Per component, the value of a particle that did not exist when the field was created (a
+  /// particle added by a source); empty: zero.
+  std::vector<double> initial = {};
 };
 
 template <int D>
@@ -51,19 +54,27 @@ class Particles {
   size_t size() const { return n_; }
 
   /// Returns the handle of a field, creating it (zero-filled) if needed. Requests with the same
-  /// name must agree on the component count.
-  int request(const FieldInfo& info) {
+  /// name must agree on the component count. With allocate = false the field is only registered
+  /// (its handle reserved, no storage) until a request allocates it.
+  int request(const FieldInfo& info, bool allocate = true) {
     for (size_t f = 0; f < fields_.size(); ++f)
       if (fields_[f].info.name == info.name) {
         if (fields_[f].info.components != info.components)
           throw std::logic_error("field '" + info.name + "' requested with different sizes");
+        if (allocate && !fields_[f].allocated) {
+          fields_[f].allocated = true;
+          for (auto& c : fields_[f].data) c.assign(n_, 0.0);
+        }
         return int(f);
       }
-    Field f{info, std::vector<std::vector<double>>(size_t(info.components))};
-    for (auto& c : f.data) c.assign(n_, 0.0);
+    Field f{info, std::vector<std::vector<double>>(size_t(info.components)), allocate};
+    if (allocate)
+      for (auto& c : f.data) c.assign(n_, 0.0);
     fields_.push_back(std::move(f));
     return int(fields_.size() - 1);
   }
+  /// Whether a field is stored in this set (registered and allocated).
+  bool has(int field) const { return field >= 0 && fields_[size_t(field)].allocated; }
   int find(const std::string& name) const {
     for (size_t f = 0; f < fields_.size(); ++f)
       if (fields_[f].info.name == name) return int(f);
@@ -89,13 +100,35 @@ class Particles {
   std::vector<uint16_t> material;
   std::vector<uint16_t> body;
 
+  /// Grow or shrink every column; new particles get each field's `initial` value.
   void resize(size_t n) {
     n_ = n;
     for (auto& f : fields_)
-      for (auto& c : f.data) c.resize(n, 0.0);
+      if (f.allocated)
+        for (size_t c = 0; c < f.data.size(); ++c)
+          f.data[c].resize(n, c < f.info.initial.size() ? f.info.initial[c] : 0.0);
     id.resize(n);
     material.resize(n);
     body.resize(n);
+  }
+
+  /// Remove the particles with remove[i] != 0 from every column, keeping the others' order.
+  void erase(const std::vector<uint8_t>& remove) {
+    auto compact = [&](auto& v) {
+      size_t k = 0;
+      for (size_t i = 0; i < n_; ++i)
+        if (!remove[i]) v[k++] = v[i];
+      v.resize(k);
+      return k;
+    };
+    size_t kept = n_;
+    for (auto& f : fields_)
+      if (f.allocated)
+        for (auto& c : f.data) kept = compact(c);
+    compact(id);
+    compact(material);
+    kept = compact(body);
+    n_ = kept;
   }
 
   /// Reorder every column so that new[i] = old[order[i]] (after sorting by cell).
@@ -103,7 +136,8 @@ class Particles {
     // Columns are independent: permute them in parallel, one scratch column per thread.
     std::vector<std::vector<double>*> columns;
     for (auto& f : fields_)
-      for (auto& c : f.data) columns.push_back(&c);
+      if (f.allocated)
+        for (auto& c : f.data) columns.push_back(&c);
     scratch_.resize(size_t(threads));
     const int nc = int(columns.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
@@ -123,15 +157,22 @@ class Particles {
   /// identity on first request. Schemes update it with F <- (I + L dt) F when it exists, so it
   /// costs nothing unless a plugin (CPDI, a hyperelastic material, ...) asks for it.
   int request_deformation_gradient() {
-    const bool is_new = find("deformation_gradient") < 0;
-    std::vector<std::string> names;
-    for (int i = 0; i < D; ++i)
-      for (int j = 0; j < D; ++j) names.push_back(std::string(1, "xyz"[i]) + "xyz"[j]);
-    const int h = request({"deformation_gradient", D * D, "-", "deformation gradient F", names});
+    const bool is_new = !has(find("deformation_gradient"));
+    const int h = request(deformation_gradient_info());
     if (is_new)
       for (int i = 0; i < D; ++i)
         for (size_t p = 0; p < n_; ++p) col(h, i * D + i)[p] = 1.0;
     return h;
+  }
+
+  static FieldInfo deformation_gradient_info() {
+    std::vector<std::string> names;
+    std::vector<double> identity(D * D, 0.0);
+    for (int i = 0; i < D; ++i) {
+      identity[size_t(i * D + i)] = 1.0;
+      for (int j = 0; j < D; ++j) names.push_back(std::string(1, "xyz"[i]) + "xyz"[j]);
+    }
+    return {"deformation_gradient", D * D, "-", "deformation gradient F", names, identity};
   }
 
   /// Every field value of particle i (all components, field order), e.g. to retry a material
@@ -139,18 +180,21 @@ class Particles {
   std::vector<double> state_of(size_t i) const {
     std::vector<double> s;
     for (const auto& f : fields_)
-      for (const auto& c : f.data) s.push_back(c[i]);
+      if (f.allocated)
+        for (const auto& c : f.data) s.push_back(c[i]);
     return s;
   }
   void restore_state(size_t i, const std::vector<double>& s) {
     size_t k = 0;
     for (auto& f : fields_)
-      for (auto& c : f.data) c[i] = s[k++];
+      if (f.allocated)
+        for (auto& c : f.data) c[i] = s[k++];
   }
 
   size_t bytes_per_particle() const {
     size_t b = sizeof(uint32_t) + 2 * sizeof(uint16_t);
-    for (const auto& f : fields_) b += sizeof(double) * size_t(f.info.components);
+    for (const auto& f : fields_)
+      if (f.allocated) b += sizeof(double) * size_t(f.info.components);
     return b;
   }
 
@@ -169,6 +213,7 @@ class Particles {
   struct Field {
     FieldInfo info;
     std::vector<std::vector<double>> data;
+    bool allocated = true;
   };
   template <class T>
   void permute_int(std::vector<T>& v, const std::vector<uint32_t>& order) {

@@ -8,7 +8,8 @@
 // per material. Slabs are coloured alternately: two slabs of one colour are separated by more
 // rows than the stencil reaches, so they never write the same node, and a
 // particle-to-grid scatter runs race-free without atomics or locks: all colour-0 slabs in
-// parallel, then all colour-1 slabs (DESIGN.md "Hot loop"; measured 1.7-1.8x on 2 threads).
+// parallel, then all colour-1 slabs (docs/architecture.md "Threads without locks";
+// measured 1.7-1.8x on 2 threads).
 //
 // Between sorts particles drift; verify() measures each slab's actual row extent every step and
 // reports when the colouring is no longer safe, so the caller re-sorts.
@@ -39,6 +40,10 @@ class Partition {
   std::vector<Slab> slabs;
   std::vector<IndexRange> material_ranges;
   int threads = 1;
+  size_t sorted_count = 0;  // particles at the last sort
+
+  /// Whether the slabs cover exactly n particles (false after a source added some).
+  bool covers(size_t n) const { return sorted_count == n; }
 
   /// Sort particles by (material, cell) and rebuild slabs. `reach` = rows_below + rows_above
   /// of the shape function.

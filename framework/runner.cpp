@@ -46,6 +46,7 @@ template <int D>
 struct Probe {
   std::string name;
   bool on_node = false;
+  int set = 0;
   uint32_t particle_id = 0;
   size_t node = 0;
   std::vector<std::string> fields;
@@ -103,9 +104,14 @@ class Run {
   long frames_ = 0;
 
   void check_outputs(Diagnostics& diag) {
-    Particles<D>& p = sim_->particles;
+    // Every set has the same field layout; a name is known if some set stores it.
+    const Particles<D>& p = sim_->sets[0].particles;
     std::vector<std::string> known;
-    for (int f = 0; f < p.num_fields(); ++f) known.push_back(p.info(f).name);
+    for (int f = 0; f < p.num_fields(); ++f) {
+      bool stored = false;
+      for (const auto& s : sim_->sets) stored = stored || s.particles.has(f);
+      if (stored) known.push_back(p.info(f).name);
+    }
     known.push_back("displacement");
     auto check_name = [&](const Params& sec, size_t i, const std::string& name, bool node) {
       std::vector<std::string> options = known;
@@ -128,7 +134,7 @@ class Run {
         if (derived_field(names[i]))
           need_disp = true;
         else if (names[i] != "position")
-          frame_fields_.push_back(p.find(names[i]));
+          frame_fields_.push_back(p.find(names[i]));  // one layout: valid in every set
       }
     for (const auto& pr : cfg_.params.list("probes")) {
       Probe<D> probe;
@@ -160,15 +166,27 @@ class Run {
         }
         probe.node = idx;
       } else {
+        probe.set = sim_->set_param(pr, "set", diag);
+        if (probe.set < 0) continue;
+        const Particles<D>& ps = sim_->sets[size_t(probe.set)].particles;
+        for (const auto& name : probe.fields)
+          if (!derived_field(name) && !ps.has(ps.find(name)))
+            diag.error(pr.where("fields"), pr.path("fields"),
+                       "particle set '" + sim_->sets[size_t(probe.set)].name +
+                           "' does not store field '" + name + "'");
+        if (ps.size() == 0) {
+          diag.error(pr.where("set"), pr.path("set"), "the particle set has no particles");
+          continue;
+        }
         const auto& target = pr.vec("particle_near");
         double best = 1e300;
-        for (size_t i = 0; i < p.size(); ++i) {
+        for (size_t i = 0; i < ps.size(); ++i) {
           double r2 = 0;
           for (int d = 0; d < D; ++d) {
-            double dx = p.col(p.position, d)[i] - target[size_t(d)];
+            double dx = ps.col(ps.position, d)[i] - target[size_t(d)];
             r2 += dx * dx;
           }
-          if (r2 < best) best = r2, probe.particle_id = p.id[i];
+          if (r2 < best) best = r2, probe.particle_id = ps.id[i];
         }
       }
       probes_.push_back(std::move(probe));
@@ -179,13 +197,16 @@ class Run {
           diag.error(cfg_.params.where("probes"), "probes." + std::to_string(i) + ".name",
                      "duplicate probe name '" + probes_[i].name + "'");
     if (need_disp) {
-      initial_position_ =
-          p.request({"initial_position", D, "m", "position at t = 0", Particles<D>::axis_names()});
-      displacement_ = p.request(
+      initial_position_ = sim_->request_field(
+          {"initial_position", D, "m", "position at t = 0", Particles<D>::axis_names()});
+      displacement_ = sim_->request_field(
           {"displacement", D, "m", "position minus initial position", Particles<D>::axis_names()});
-      for (int d = 0; d < D; ++d)
-        std::copy(p.col(p.position, d), p.col(p.position, d) + p.size(),
-                  p.col(initial_position_, d));
+      for (auto& s : sim_->sets) {
+        Particles<D>& ps = s.particles;
+        for (int d = 0; d < D; ++d)
+          std::copy(ps.col(ps.position, d), ps.col(ps.position, d) + ps.size(),
+                    ps.col(initial_position_, d));
+      }
       for (const auto& n : names)
         if (n == "displacement") frame_fields_.push_back(displacement_);
     }
@@ -214,12 +235,14 @@ class Run {
 
   void refresh_derived() {
     if (displacement_ < 0) return;
-    Particles<D>& p = sim_->particles;
-    for (int d = 0; d < D; ++d) {
-      const double* x = p.col(p.position, d);
-      const double* x0 = p.col(initial_position_, d);
-      double* u = p.col(displacement_, d);
-      for (size_t i = 0; i < p.size(); ++i) u[i] = x[i] - x0[i];
+    for (auto& s : sim_->sets) {
+      Particles<D>& p = s.particles;
+      for (int d = 0; d < D; ++d) {
+        const double* x = p.col(p.position, d);
+        const double* x0 = p.col(initial_position_, d);
+        double* u = p.col(displacement_, d);
+        for (size_t i = 0; i < p.size(); ++i) u[i] = x[i] - x0[i];
+      }
     }
   }
 
@@ -232,6 +255,7 @@ class Run {
     for (int d = 0; d < D; ++d)
       history_.out() << ",momentum_"
                      << "xyz"[d];
+    if (exchanges_particles()) history_.out() << ",particles,mass_created,mass_removed";
     history_.out() << "\n";
     for (auto& pr : probes_) {
       pr.csv.open(dir_ / ("probe_" + pr.name + ".csv"));
@@ -244,9 +268,10 @@ class Run {
             if (g.name == f) nc = g.components;
           for (int c = 0; c < nc; ++c) names.push_back(nc > 1 ? std::string(1, "xyz"[c]) : "");
         } else {
-          int h = f == "displacement" ? displacement_ : sim_->particles.find(f);
-          nc = sim_->particles.info(h).components;
-          names = sim_->particles.info(h).component_names;
+          const Particles<D>& p = sim_->sets[size_t(pr.set)].particles;
+          int h = f == "displacement" ? displacement_ : p.find(f);
+          nc = p.info(h).components;
+          names = p.info(h).component_names;
         }
         for (int c = 0; c < nc; ++c)
           pr.csv.out() << "," << f << (nc > 1 ? "_" + names[size_t(c)] : "");
@@ -267,8 +292,9 @@ class Run {
               for (int c = 0; c < g.components; ++c)
                 o << "," << g.base[pr.node * size_t(g.stride) + size_t(g.offset + c)];
       } else {
-        Particles<D>& p = sim_->particles;
-        size_t i = sim_->index_of(pr.particle_id);
+        const ParticleSet<D>& set = sim_->sets[size_t(pr.set)];
+        const Particles<D>& p = set.particles;
+        size_t i = set.index_of(pr.particle_id);
         for (const auto& f : pr.fields) {
           if (f == "displacement") {
             for (int d = 0; d < D; ++d)
@@ -290,8 +316,12 @@ class Run {
     o << sim_->step << "," << sim_->time << "," << sim_->dt << "," << e.kinetic << "," << e.strain
       << "," << e.gravity << "," << e.kinetic + strain + e.gravity;
     for (double m : e.momentum) o << "," << m;
+    if (exchanges_particles())
+      o << "," << sim_->num_particles() << "," << sim_->mass_created << "," << sim_->mass_removed;
     o << "\n";
   }
+
+  bool exchanges_particles() const { return !sim_->sources.empty() || !sim_->sinks.empty(); }
 
   void write_frame(const std::string& label) {
     refresh_derived();
@@ -306,12 +336,34 @@ class Run {
     s["config_file"] = cfg_.file;
     s["config"] = cfg_.params.to_json();
     s["dimension"] = D;
-    s["particles"] = sim_->particles.size();
+    s["particles"] = sim_->num_particles();
+    nlohmann::json sets = nlohmann::json::object();
+    for (const auto& set : sim_->sets) {
+      std::vector<std::string> bodies;
+      for (int b : set.bodies)
+        bodies.push_back(sim_->bodies.size() > size_t(b) ? sim_->bodies[size_t(b)].name : "");
+      double mass = 0, kinetic = 0;  // the particles' own (a scheme's second phase not included)
+      const Particles<D>& P = set.particles;
+      for (size_t i = 0; i < P.size(); ++i) {
+        const double m = P.col(P.mass)[i];
+        mass += m;
+        for (int d = 0; d < D; ++d) kinetic += 0.5 * m * std::pow(P.col(P.velocity, d)[i], 2);
+      }
+      sets[set.name] = {{"particles", set.size()},
+                        {"mass", mass},
+                        {"kinetic_energy", kinetic},
+                        {"bodies", bodies},
+                        {"bytes_per_particle", set.particles.bytes_per_particle()}};
+    }
+    s["sets"] = sets;
     s["cells"] = sim_->grid.num_cells;
     s["nodes"] = sim_->grid.num_nodes;
     s["shape_function"] = sim_->config.section("shape_function").type();
     s["scheme"] = sim_->config.section("scheme").type();
-    s["bytes_per_particle"] = sim_->particles.bytes_per_particle();
+    size_t bytes = 0;
+    for (const auto& set : sim_->sets) bytes += set.size() * set.particles.bytes_per_particle();
+    s["bytes_per_particle"] = sim_->num_particles() ? bytes / sim_->num_particles()
+                                                    : sim_->sets[0].particles.bytes_per_particle();
     return s;
   }
 
@@ -323,7 +375,6 @@ class Run {
     double every_time = out.has("every_time") ? out.real("every_time") : 0;
     if (!every_steps && every_time <= 0) every_time = sim.end_time / 20;
     const long history_every = long(out.integer("history_every"));
-    const long check_every = long(cfg_.params.section("numerics").integer("check_every"));
     double next_frame_time = every_time;
     const bool files = opt_.write_output;
     if (files) {
@@ -353,31 +404,25 @@ class Run {
         break;
       }
       if (sim.time + dt > t_end) dt = t_end - sim.time;
-      sim.dt = dt;
       dt_min = std::min(dt_min, dt);
       dt_max = std::max(dt_max, dt);
-      sim.prepare_particle_loads();
-      sim.shape->begin_step(sim);
-      if (!sim.failure.empty()) {
+      // Whether the step ends at a frame or the end (the particles are then always checked).
+      const long next_step = sim.step + 1;
+      const double next_time = sim.time + dt;
+      const bool frame_due =
+          files && ((every_steps && next_step % every_steps == 0) ||
+                    (every_time > 0 && next_time >= next_frame_time * (1 - 1e-9)));
+      const bool last = next_time >= t_end * (1 - 1e-12) || next_step == opt_.max_steps;
+      if (!sim.advance(dt, frame_due || last)) {
         failure = sim.failure;
         break;
       }
-      sim.scheme->step(sim, dt);
-      sim.time += dt;
-      ++sim.step;
       if (sim.step >= sim.max_steps && sim.time < t_end * (1 - 1e-12)) {
         failure = "time.max_steps = " + std::to_string(sim.max_steps) +
                   " reached before t = " + format_number(t_end) + " s; the time step fell to " +
                   format_number(dt) + " s (it was " + format_number(dt_max) + " s at most)";
         break;
       }
-      bool frame_due = files && ((every_steps && sim.step % every_steps == 0) ||
-                                 (every_time > 0 && sim.time >= next_frame_time * (1 - 1e-9)));
-      bool last = sim.time >= t_end * (1 - 1e-12) || sim.step == opt_.max_steps;
-      if (sim.step % check_every == 0 || frame_due || last) {
-        if (!sim.check_particles(failure)) break;
-      }
-      sim.timed("partition", [&] { sim.maintain_partition(); });
       if (sim.reference) sim.reference->sample(sim);
       if (files) {
         sample_probes(last);
@@ -411,7 +456,7 @@ class Run {
     res.summary["wall_seconds"] = wall;
     res.summary["threads"] = sim.threads;
     res.summary["particle_steps_per_second"] =
-        wall > 0 ? double(sim.particles.size()) * double(sim.step) / wall : 0.0;
+        wall > 0 ? double(sim.num_particles()) * double(sim.step) / wall : 0.0;
     res.summary["dt_min"] = dt_min < 1e300 ? dt_min : 0.0;
     res.summary["dt_max"] = dt_max;
     res.summary["frames"] = frames_;
@@ -424,6 +469,16 @@ class Run {
           {"gravity", e.gravity},
           {"momentum", e.momentum}};
     };
+    // Sources and sinks: counts and the mass balance (round-off when nothing is lost).
+    const double mass_now = sim.total_mass();
+    res.summary["particles_created"] = sim.created;
+    res.summary["particles_removed"] = sim.removed;
+    res.summary["mass"] = {
+        {"initial", sim.initial_mass},
+        {"final", mass_now},
+        {"created", sim.mass_created},
+        {"removed", sim.mass_removed},
+        {"balance", mass_now + sim.mass_removed - sim.mass_created - sim.initial_mass}};
     res.summary["energy_initial"] = energy_json(e0);
     res.summary["energy_final"] = energy_json(e1);
     if (sim.reference) {
@@ -456,7 +511,7 @@ class Run {
     if (!opt_.quiet && failure.empty())
       spdlog::info(
           "done: {} steps, {} particles, {:.3g} s wall, {:.3g} M particle-steps/s on {} thread(s)",
-          sim.step, sim.particles.size(), wall,
+          sim.step, sim.num_particles(), wall,
           res.summary["particle_steps_per_second"].get<double>() / 1e6, sim.threads);
     return res;
   }

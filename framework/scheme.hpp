@@ -8,6 +8,7 @@
 
 #include "energies.hpp"
 #include "params.hpp"
+#include "particle_set.hpp"
 
 namespace loam {
 
@@ -27,8 +28,17 @@ class Scheme {
  public:
   static constexpr const char* kind = "scheme";
   virtual ~Scheme() = default;
+  /// The particle sets the scheme works with, in order; the first is the default of a body's
+  /// `set:`. Known before set-up (the Simulation creates the sets from it).
+  virtual std::vector<SetDeclaration> particle_sets() const {
+    return {{"particles", "the material points"}};
+  }
   /// Request particle fields and allocate node storage.
   virtual void setup(Simulation<D>&, Diagnostics&) = 0;
+  /// Initialise the scheme's fields of particles [begin, end) of a set: every particle at
+  /// set-up, and particles a source adds later (Simulation::add_particles).
+  virtual void initialize_particles(Simulation<D>&, ParticleSet<D>&, size_t /*begin*/,
+                                    size_t /*end*/) {}
   /// A time-step limit of the scheme's own (e.g. explicit drag), on top of the CFL limit.
   virtual double stable_dt(const Simulation<D>&) const {
     return std::numeric_limits<double>::infinity();

@@ -14,6 +14,8 @@ namespace loam {
 
 template <int D>
 class Simulation;
+template <int D>
+class ParticleSet;
 class Diagnostics;
 
 constexpr int kBlock = 64;
@@ -48,6 +50,10 @@ class ShapeFunction {
   virtual int rows_above() const = 0;
   /// Request particle fields (e.g. particle domain sizes) and check the set-up.
   virtual void setup(Simulation<D>&, Diagnostics&) {}
+  /// Initialise its fields of particles [begin, end) of a set: every particle at set-up, and
+  /// particles a source adds later (Simulation::add_particles).
+  virtual void initialize_particles(Simulation<D>&, ParticleSet<D>&, size_t /*begin*/,
+                                    size_t /*end*/) {}
   /// Called before every step (e.g. to update particle domains and the reach reported by
   /// rows_below/rows_above). A shape function that cannot continue (a particle domain too
   /// distorted, ...) sets Simulation::failure; the run then stops with exit code 3.

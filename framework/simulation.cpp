@@ -28,20 +28,23 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   max_steps = long(t.integer("max_steps"));
   const Params& num = config.section("numerics");
   sort_every = int(num.integer("sort_every"));
+  check_every = long(num.integer("check_every"));
   mass_tolerance = num.real("mass_tolerance");
-  for (const auto& s : config.list("particle_sets")) {
+  for (const auto& s : config.list("selections")) {
     Vec lo{}, hi{};
     for (int d = 0; d < D; ++d)
       lo[size_t(d)] = s.vec("min")[size_t(d)], hi[size_t(d)] = s.vec("max")[size_t(d)];
-    sets_.push_back({s.text("name"), {lo, hi}});
+    selections_.push_back({s.text("name"), {lo, hi}});
   }
   // From here on, keep checking after an error wherever the rest does not depend on it, so that
   // one run reports every problem at once.
   create_plugins(diag);
+  create_sets(diag);
   const size_t errors_before = diag.errors().size();
   generate_bodies(diag);
   const bool particles_ok = diag.errors().size() == errors_before;
-  if (!particles_ok) particles.resize(0);  // check the remaining set-up on an empty model
+  if (!particles_ok)
+    for (auto& s : sets) s.particles.resize(0);  // check the remaining set-up on an empty model
   // Plugins see the generated particles in set-up (e.g. to select faces or request fields).
   shape->setup(*this, diag);
   scheme->setup(*this, diag);
@@ -50,24 +53,35 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   bool particle_loads = false;
   for (auto& l : loads) particle_loads = particle_loads || l->uses_particle_forces();
   if (particle_loads)
-    external_force = particles.request(
+    external_force = request_field(
         {"external_force", D, "N", "applied external force", Particles<D>::axis_names()});
   sort();
-  for (size_t m = 0; m < materials.size(); ++m) {
-    const auto& r = partition.material_ranges[m];
-    if (r.end > r.begin) materials[m]->initialize(particles, r.begin, r.end);
-  }
+  for (auto& s : sets)
+    for (size_t m = 0; m < materials.size(); ++m) {
+      const auto& r = s.partition.material_ranges[m];
+      if (r.end > r.begin) materials[m]->initialize(s.particles, r.begin, r.end);
+    }
   for (auto& b : boundaries) b->setup(*this, diag);
   model_checked = true;
   if (!particles_ok) return;  // loads and references select particles
   for (auto& l : loads) l->setup(*this, diag);
+  for (auto& p : sources) p->setup(*this, diag);
+  for (auto& p : sinks) p->setup(*this, diag);
+  if (diag.ok()) check_sources_and_sinks(diag);
   if (reference) reference->setup(*this, diag);
   if (!diag.ok()) return;
+  // The sources act at t = 0 too (an inlet starts filled); their particles count as created.
+  initial_mass = total_mass();
+  next_id_ = uint32_t(num_particles());
+  for (auto& p : sources) p->apply(*this, time);
+  for (auto& s : sets)
+    if (s.resized) sort(s);
   double v2 = 0;
-  for (int d = 0; d < D; ++d) {
-    const double* v = particles.col(particles.velocity, d);
-    for (size_t i = 0; i < particles.size(); ++i) v2 = std::max(v2, v[i] * v[i]);
-  }
+  for (const auto& s : sets)
+    for (int d = 0; d < D; ++d) {
+      const double* v = s.particles.col(s.particles.velocity, d);
+      for (size_t i = 0; i < s.size(); ++i) v2 = std::max(v2, v[i] * v[i]);
+    }
   max_speed = std::sqrt(v2);
   // Step budget: a stiff set-up (e.g. K_w / n with a porosity near 0) can make the stable time
   // step so small that the run would never finish; say so before writing anything.
@@ -80,6 +94,20 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
                    " steps, more than time.max_steps = " + std::to_string(max_steps) +
                    " (a stiff material or pore fluid, e.g. K_w / n with a tiny porosity, or a "
                    "fine grid); raise time.max_steps if this is intended");
+}
+
+template <int D>
+void Simulation<D>::create_sets(Diagnostics& diag) {
+  for (const auto& decl : scheme->particle_sets()) {
+    sets.emplace_back();
+    sets.back().name = decl.name;
+  }
+  const auto& bl = config.list("bodies");
+  for (size_t b = 0; b < bl.size(); ++b) {
+    const int s = set_param(bl[b], "set", diag);
+    body_set_.push_back(std::max(s, 0));
+    if (s >= 0) sets[size_t(s)].bodies.push_back(int(b));
+  }
 }
 
 template <int D>
@@ -112,6 +140,8 @@ void Simulation<D>::create_plugins(Diagnostics& diag) {
   scheme = reg.create<Scheme, D>(config.section("scheme"));
   for (const auto& b : config.list("boundaries")) boundaries.push_back(reg.create<Boundary, D>(b));
   for (const auto& l : config.list("loads")) loads.push_back(reg.create<Load, D>(l));
+  for (const auto& p : config.list("sources")) sources.push_back(reg.create<Source, D>(p));
+  for (const auto& p : config.list("sinks")) sinks.push_back(reg.create<Sink, D>(p));
   if (config.has("damping")) damping = reg.create<Damping, D>(config.section("damping"));
   if (config.has("verify")) reference = reg.create<Reference, D>(config.section("verify"));
   const auto& bl = config.list("bodies");
@@ -134,6 +164,18 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
   std::vector<double> vols;
   for (size_t b = 0; b < bl.size(); ++b) {
     const Params& bp = bl[b];
+    if (!bp.has("generator")) {  // starts empty: its particles come from a source
+      Body body;
+      body.name = bp.text("name");
+      body.params = bp;
+      body.first_id = xs.size();
+      body.lower.assign(D, 0.0);
+      body.upper.assign(D, 0.0);
+      for (int d = 0; d < D; ++d)
+        body.spacing.push_back(grid.cell[size_t(d)] / double(bp.integer("particles_per_cell")));
+      bodies.push_back(std::move(body));
+      continue;
+    }
     auto gen = reg.create<Generator, D>(bp.section("generator"));
     if (std::string problem = gen->check(); !problem.empty()) {
       diag.error(bp.where("generator"), bp.path("generator"), problem);
@@ -211,32 +253,45 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
     bodies.push_back(std::move(body));
   }
   if (diag.errors().size() != errors_before) return;
-  const size_t n = xs.size();
-  if (n > size_t(UINT32_MAX)) {
+  if (xs.size() > size_t(UINT32_MAX)) {
     diag.error(config.where("bodies"), "bodies", "more than 2^32 particles");
     return;
   }
-  particles.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    particles.id[i] = uint32_t(i);
-    particles.material[i] = owner[i];
-    particles.body[i] = owner[i];
-    for (int d = 0; d < D; ++d) particles.col(particles.position, d)[i] = xs[i][size_t(d)];
-    particles.col(particles.volume)[i] = vols[i];
-    particles.col(particles.mass)[i] = vols[i] * materials[owner[i]]->density();
+  // Each set holds its bodies' particles in body order; ids count over all bodies.
+  for (auto& body : bodies) body.set = body_set_[size_t(&body - bodies.data())];
+  for (size_t si = 0; si < sets.size(); ++si) {
+    Particles<D>& P = sets[si].particles;
+    size_t n = 0;
+    for (auto& body : bodies)
+      if (body.set == int(si)) body.first_index = n, n += body.count;
+    P.resize(n);
+    for (const auto& body : bodies) {
+      if (body.set != int(si)) continue;
+      for (size_t k = 0; k < body.count; ++k) {
+        const size_t i = body.first_index + k, g = body.first_id + k;
+        P.id[i] = uint32_t(g);
+        P.material[i] = owner[g];
+        P.body[i] = owner[g];
+        for (int d = 0; d < D; ++d) P.col(P.position, d)[i] = xs[g][size_t(d)];
+        P.col(P.volume)[i] = vols[g];
+        P.col(P.mass)[i] = vols[g] * materials[owner[g]]->density();
+      }
+    }
+    sets[si].invalidate_index();
   }
   // Initial velocity and stress fields.
   std::vector<double> value(size_t(Particles<D>::NS));
   for (size_t b = 0; b < bl.size(); ++b) {
     const Params& bp = bl[b];
-    for (auto [key, field] : {std::pair<const char*, int>{"velocity", particles.velocity},
-                              std::pair<const char*, int>{"stress", particles.stress}}) {
+    Particles<D>& P = sets[size_t(bodies[b].set)].particles;
+    for (auto [key, field] : {std::pair<const char*, int>{"velocity", P.velocity},
+                              std::pair<const char*, int>{"stress", P.stress}}) {
       if (!bp.has(key)) continue;
       auto f = reg.create<Field, D>(bp.section(key));
-      const int nc = particles.info(field).components;
-      for (size_t i = bodies[b].first_id; i < bodies[b].first_id + bodies[b].count; ++i) {
-        f->value(xs[i], value.data());
-        for (int c = 0; c < nc; ++c) particles.col(field, c)[i] = value[size_t(c)];
+      const int nc = P.info(field).components;
+      for (size_t k = 0; k < bodies[b].count; ++k) {
+        f->value(xs[bodies[b].first_id + k], value.data());
+        for (int c = 0; c < nc; ++c) P.col(field, c)[bodies[b].first_index + k] = value[size_t(c)];
       }
     }
   }
@@ -244,12 +299,13 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
 
 template <int D>
 void Simulation<D>::initialize_fields(Diagnostics& diag) {
-  // Before the first sort: particle index = id, so a body's particles are its id range.
+  // Before the first sort a body's particles are one index range of its set.
   const auto& bl = config.list("bodies");
   for (size_t b = 0; b < bl.size() && b < bodies.size(); ++b)
     for (const Params& e : bl[b].list("initial")) {
+      Particles<D>& particles = sets[size_t(bodies[b].set)].particles;
       const std::string name = e.text("field");
-      const int h = particles.find(name);
+      const int h = particles.has(particles.find(name)) ? particles.find(name) : -1;
       // Scalar: one component without component names (1D vectors have one component too).
       auto scalar = [&](int k) {
         return particles.info(k).components == 1 && particles.info(k).component_names.empty();
@@ -257,7 +313,7 @@ void Simulation<D>::initialize_fields(Diagnostics& diag) {
       if (h < 0 || !scalar(h)) {
         std::vector<std::string> scalars;
         for (int k = 0; k < particles.num_fields(); ++k)
-          if (scalar(k)) scalars.push_back(particles.info(k).name);
+          if (particles.has(k) && scalar(k)) scalars.push_back(particles.info(k).name);
         diag.error(e.where("field"), e.path("field"),
                    (h < 0 ? "no particle field '" : "'") + name +
                        (h < 0 ? "'" : "' is not a scalar field") +
@@ -266,7 +322,7 @@ void Simulation<D>::initialize_fields(Diagnostics& diag) {
       }
       auto f = Registry::instance().create<Field, D>(e.section("value"));
       std::array<double, D> x{};
-      for (size_t i = bodies[b].first_id; i < bodies[b].first_id + bodies[b].count; ++i) {
+      for (size_t i = bodies[b].first_index; i < bodies[b].first_index + bodies[b].count; ++i) {
         for (int d = 0; d < D; ++d) x[size_t(d)] = particles.col(particles.position, d)[i];
         f->value(x, particles.col(h) + i);
       }
@@ -277,82 +333,240 @@ template <int D>
 double Simulation<D>::stable_dt() const {
   if (fixed_dt > 0) return fixed_dt;
   double c = 0;
-  for (size_t m = 0; m < materials.size(); ++m) {
-    const auto& r = partition.material_ranges[m];
-    if (r.end > r.begin) c = std::max(c, materials[m]->wave_speed(particles, r.begin, r.end));
-  }
+  for (const auto& s : sets)
+    for (size_t m = 0; m < materials.size(); ++m) {
+      const auto& r = s.partition.material_ranges[m];
+      if (r.end > r.begin) c = std::max(c, materials[m]->wave_speed(s.particles, r.begin, r.end));
+    }
   double dt_cfl = cfl * grid.min_cell() / std::max(c + max_speed, 1e-300);
   return std::min(dt_cfl, scheme->stable_dt(*this));
 }
 
 template <int D>
+bool Simulation<D>::advance(double step_dt, bool check) {
+  dt = step_dt;
+  prepare_particle_loads();
+  shape->begin_step(*this);
+  if (!failure.empty()) return false;
+  scheme->step(*this, dt);
+  time += dt;
+  ++step;
+  if (!failure.empty()) return false;
+  exchange_particles();
+  // Check before sorting: the sort must not see non-finite positions.
+  if ((check || step % check_every == 0) && !check_particles(failure)) return false;
+  timed("partition", [&] { maintain_partition(); });
+  return true;
+}
+
+template <int D>
+void Simulation<D>::add_particles(int b, const std::vector<Vec>& x, const Vec& v) {
+  if (x.empty()) return;
+  const Body& body = bodies[size_t(b)];
+  ParticleSet<D>& set = sets[size_t(body.set)];
+  Particles<D>& P = set.particles;
+  const size_t begin = P.size(), end = begin + x.size();
+  P.resize(end);
+  double vol = 1;
+  for (int d = 0; d < D; ++d) vol *= body.spacing[size_t(d)];
+  for (size_t i = begin; i < end; ++i) {
+    P.id[i] = next_id_++;
+    P.material[i] = uint16_t(b);
+    P.body[i] = uint16_t(b);
+    for (int d = 0; d < D; ++d) {
+      P.col(P.position, d)[i] = x[i - begin][size_t(d)];
+      P.col(P.velocity, d)[i] = v[size_t(d)];
+    }
+    P.col(P.volume)[i] = vol;
+    P.col(P.mass)[i] = vol * materials[size_t(b)]->density();
+  }
+  // The same initialisation as at set-up, on the new range only.
+  shape->initialize_particles(*this, set, begin, end);
+  scheme->initialize_particles(*this, set, begin, end);
+  materials[size_t(b)]->initialize(P, begin, end);
+  const int x0 = P.find("initial_position");  // the output's displacement reference
+  if (P.has(x0))
+    for (int d = 0; d < D; ++d)
+      std::copy(P.col(P.position, d) + begin, P.col(P.position, d) + end, P.col(x0, d) + begin);
+  for (size_t i = begin; i < end; ++i) mass_created += P.col(P.mass)[i];
+  created += x.size();
+  set.invalidate_index();
+  set.resized = true;
+}
+
+template <int D>
+void Simulation<D>::exchange_particles() {
+  apply_sinks();
+  for (auto& p : sources) p->apply(*this, time);
+}
+
+template <int D>
+void Simulation<D>::apply_sinks() {
+  if (sinks.empty()) return;
+  std::vector<uint8_t> remove;
+  for (auto& set : sets) {
+    remove.assign(set.size(), 0);
+    for (const auto& k : sinks) k->mark(*this, set, remove);
+    size_t n = 0;
+    const double* m = set.particles.col(set.particles.mass);
+    for (size_t i = 0; i < set.size(); ++i)
+      if (remove[i]) mass_removed += m[i], ++n;
+    if (n == 0) continue;
+    set.particles.erase(remove);
+    set.invalidate_index();
+    set.resized = true;
+    removed += n;
+  }
+}
+
+template <int D>
+double Simulation<D>::total_mass() const {
+  double m = 0;
+  for (const auto& set : sets) {
+    const double* ms = set.particles.col(set.particles.mass);
+    for (size_t i = 0; i < set.size(); ++i) m += ms[i];
+  }
+  return m;
+}
+
+template <int D>
+void Simulation<D>::check_sources_and_sinks(Diagnostics& diag) {
+  const auto& sp = config.list("sources");
+  const auto& kp = config.list("sinks");
+  for (size_t i = 0; i < sources.size(); ++i) {
+    Vec lo{}, hi{};
+    sources[i]->region(lo, hi);
+    for (size_t k = 0; k < sinks.size(); ++k)
+      if (sinks[k]->overlaps(lo, hi))
+        diag.error(kp[k].where(), kp[k].path(),
+                   "the sink overlaps the region of " + sp[i].path() +
+                       ": it would remove the particles the source creates");
+  }
+}
+
+template <int D>
 void Simulation<D>::prepare_particle_loads() {
   if (external_force < 0) return;
-  for (int d = 0; d < D; ++d) {
-    double* f = particles.col(external_force, d);
-    std::fill(f, f + particles.size(), 0.0);
-  }
+  for (auto& s : sets)
+    for (int d = 0; d < D; ++d) {
+      double* f = s.particles.col(external_force, d);
+      std::fill(f, f + s.size(), 0.0);
+    }
   for (auto& l : loads) l->apply_to_particles(*this, time);
 }
 
 template <int D>
+void Simulation<D>::sort(ParticleSet<D>& s) {
+  s.partition.sort(s.particles, grid, int(materials.size()),
+                   shape->rows_below() + shape->rows_above(), threads);
+  s.invalidate_index();
+  s.resized = false;
+  s.last_sort = step;
+}
+
+template <int D>
 void Simulation<D>::sort() {
-  partition.sort(particles, grid, int(materials.size()), shape->rows_below() + shape->rows_above(),
-                 threads);
-  index_valid_ = false;
-  last_sort_ = step;
+  for (auto& s : sets) sort(s);
 }
 
 template <int D>
 void Simulation<D>::maintain_partition() {
-  bool ok = partition.verify(particles, grid, shape->rows_below(), shape->rows_above());
-  if (!ok || step - last_sort_ >= sort_every) sort();
+  for (auto& s : sets) {
+    // A changed count (sources, sinks) needs new slabs; otherwise sort when drift requires it.
+    bool ok = !s.resized &&
+              s.partition.verify(s.particles, grid, shape->rows_below(), shape->rows_above());
+    if (!ok || step - s.last_sort >= sort_every) sort(s);
+  }
 }
 
 template <int D>
 Energies Simulation<D>::energies() const {
   Energies e;
   e.momentum.assign(D, 0.0);
-  const double* m = particles.col(particles.mass);
-  for (int d = 0; d < D; ++d) {
-    const double* v = particles.col(particles.velocity, d);
-    const double* x = particles.col(particles.position, d);
-    for (size_t i = 0; i < particles.size(); ++i) {
-      e.kinetic += 0.5 * m[i] * v[i] * v[i];
-      e.momentum[size_t(d)] += m[i] * v[i];
-      e.gravity -= m[i] * gravity[size_t(d)] * x[i];
+  for (const auto& s : sets) {
+    const Particles<D>& P = s.particles;
+    const double* m = P.col(P.mass);
+    for (int d = 0; d < D; ++d) {
+      const double* v = P.col(P.velocity, d);
+      const double* x = P.col(P.position, d);
+      for (size_t i = 0; i < P.size(); ++i) {
+        e.kinetic += 0.5 * m[i] * v[i] * v[i];
+        e.momentum[size_t(d)] += m[i] * v[i];
+        e.gravity -= m[i] * gravity[size_t(d)] * x[i];
+      }
     }
-  }
-  for (size_t mat = 0; mat < materials.size(); ++mat) {
-    const auto& r = partition.material_ranges[mat];
-    if (r.end > r.begin) e.strain += materials[mat]->strain_energy(particles, r.begin, r.end);
+    for (size_t mat = 0; mat < materials.size(); ++mat) {
+      const auto& r = s.partition.material_ranges[mat];
+      if (r.end > r.begin) e.strain += materials[mat]->strain_energy(P, r.begin, r.end);
+    }
   }
   scheme->add_energies(*this, e);
   return e;
 }
 
 template <int D>
-size_t Simulation<D>::index_of(uint32_t id) const {
-  if (!index_valid_) {
-    index_of_id_.resize(particles.size());
-    for (size_t i = 0; i < particles.size(); ++i) index_of_id_[particles.id[i]] = uint32_t(i);
-    index_valid_ = true;
+int Simulation<D>::request_field(const FieldInfo& info, int only) {
+  int h = -1;
+  for (size_t s = 0; s < sets.size(); ++s) {
+    const int hs = sets[s].particles.request(info, only < 0 || int(s) == only);
+    if (h >= 0 && hs != h)
+      throw std::logic_error("field '" + info.name +
+                             "': sets have different layouts (request fields through "
+                             "Simulation::request_field)");
+    h = hs;
   }
-  return index_of_id_[id];
+  return h;
 }
 
 template <int D>
-bool Simulation<D>::particle_set(const std::string& name, std::vector<uint32_t>& ids) const {
+int Simulation<D>::request_deformation_gradient() {
+  for (auto& s : sets) deformation_gradient = s.particles.request_deformation_gradient();
+  return deformation_gradient;
+}
+
+template <int D>
+size_t Simulation<D>::num_particles() const {
+  size_t n = 0;
+  for (const auto& s : sets) n += s.size();
+  return n;
+}
+
+template <int D>
+int Simulation<D>::set_index(const std::string& name) const {
+  for (size_t s = 0; s < sets.size(); ++s)
+    if (sets[s].name == name) return int(s);
+  return -1;
+}
+
+template <int D>
+int Simulation<D>::set_param(const Params& p, const std::string& key, Diagnostics& diag) const {
+  if (!p.has(key)) return 0;
+  const int s = set_index(p.text(key));
+  if (s < 0) {
+    std::vector<std::string> names;
+    for (const auto& decl : scheme->particle_sets())
+      names.push_back(decl.name + " (" + decl.meaning + ")");
+    diag.error(p.where(key), p.path(key),
+               "unknown particle set '" + p.text(key) + "'; scheme '" +
+                   config.section("scheme").type() + "' has: " + join(names, ", "));
+  }
+  return s;
+}
+
+template <int D>
+bool Simulation<D>::selection(const std::string& name, const ParticleSet<D>& set,
+                              std::vector<uint32_t>& ids) const {
   ids.clear();
-  for (const auto& [n, box] : sets_) {
+  const Particles<D>& P = set.particles;
+  for (const auto& [n, box] : selections_) {
     if (n != name) continue;
-    for (size_t i = 0; i < particles.size(); ++i) {
+    for (size_t i = 0; i < P.size(); ++i) {
       bool in = true;
       for (int d = 0; d < D; ++d) {
-        double x = particles.col(particles.position, d)[i];
+        double x = P.col(P.position, d)[i];
         in = in && x >= box.first[size_t(d)] && x <= box.second[size_t(d)];
       }
-      if (in) ids.push_back(particles.id[i]);
+      if (in) ids.push_back(P.id[i]);
     }
     return true;
   }
@@ -361,13 +575,21 @@ bool Simulation<D>::particle_set(const std::string& name, std::vector<uint32_t>&
 
 template <int D>
 int Simulation<D>::body_param(const Params& p, const std::string& key, Diagnostics& diag) const {
-  if (!p.has(key)) return 0;
+  if (!p.has(key)) {  // the first body with particles at t = 0
+    for (size_t b = 0; b < bodies.size(); ++b)
+      if (bodies[b].count > 0) return int(b);
+    return 0;
+  }
   const int b = body_index(p.text(key));
   if (b < 0) {
     std::vector<std::string> names;
     for (const auto& bd : bodies) names.push_back(bd.name);
     diag.error(p.where(key), p.path(key),
                "unknown body '" + p.text(key) + "'; bodies are: " + join(names, ", "));
+  } else if (bodies[size_t(b)].count == 0) {
+    diag.error(p.where(key), p.path(key),
+               "body '" + p.text(key) + "' has no particles at t = 0 (no generator)");
+    return -1;
   }
   return b;
 }
@@ -381,7 +603,15 @@ int Simulation<D>::body_index(const std::string& name) const {
 
 template <int D>
 bool Simulation<D>::check_particles(std::string& what) const {
+  for (const auto& s : sets)
+    if (!check_particles(s, what)) return false;
+  return true;
+}
+
+template <int D>
+bool Simulation<D>::check_particles(const ParticleSet<D>& set, std::string& what) const {
   // Parallel scan for the first bad particle; the message is built only on failure.
+  const Particles<D>& particles = set.particles;
   const size_t n = particles.size();
   const int nf = 3;
   const int fields[nf] = {particles.position, particles.velocity, particles.stress};
@@ -414,8 +644,8 @@ bool Simulation<D>::check_particles(std::string& what) const {
               format_number(grid.origin[size_t(d)]) + ", " + format_number(grid.upper(d)) + "])";
   }
   std::ostringstream s;
-  s << "particle " << particles.id[bad] << " (body '" << bodies[particles.body[bad]].name
-    << "'): " << field;
+  s << "particle " << particles.id[bad] << " (body '" << bodies[particles.body[bad]].name << "'"
+    << (sets.size() > 1 ? ", set '" + set.name + "'" : "") << "): " << field;
   what = s.str();
   return false;
 }

@@ -1,7 +1,7 @@
 #pragma once
 // The state of one run and the hooks schemes call. A scheme owns the order of a step; this class
-// owns everything else: grid, particles, plugins, time, partition, and the points where boundary
-// conditions, loads and damping act (DESIGN.md "The step, and where plugins hook in").
+// owns everything else: grid, particle sets, plugins, time, and the points where boundary
+// conditions, loads and damping act (docs/architecture.md "The step").
 #include <omp.h>
 
 #include <array>
@@ -21,11 +21,12 @@
 #include "load.hpp"
 #include "material.hpp"
 #include "params.hpp"
-#include "particles.hpp"
-#include "partition.hpp"
+#include "particle_set.hpp"
 #include "reference.hpp"
 #include "scheme.hpp"
 #include "shape_function.hpp"
+#include "sink.hpp"
+#include "source.hpp"
 #include "writer.hpp"
 
 namespace loam {
@@ -36,6 +37,8 @@ struct Body {
   size_t first_id = 0, count = 0;    // particle ids [first_id, first_id + count)
   std::vector<double> lower, upper;  // bounding box of the particles' domains
   std::vector<double> spacing;       // particle spacing per axis
+  int set = 0;                       // index into Simulation::sets
+  size_t first_index = 0;            // index of its first particle in its set before any sort
 };
 
 template <int D>
@@ -50,14 +53,17 @@ class Simulation {
 
   Params config;
   Grid<D> grid;
-  Particles<D> particles;
-  Partition<D> partition;
+  /// The particle sets, in the order the scheme declares them; created before any plugin set-up
+  /// and never added to or removed afterwards (references to them stay valid).
+  std::vector<ParticleSet<D>> sets;
   std::unique_ptr<ShapeFunction<D>> shape;
   std::unique_ptr<Scheme<D>> scheme;
   std::vector<std::unique_ptr<Material<D>>> materials;  // one per body, index = material id
   std::vector<Body> bodies;
   std::vector<std::unique_ptr<Boundary<D>>> boundaries;
   std::vector<std::unique_ptr<Load<D>>> loads;
+  std::vector<std::unique_ptr<Source<D>>> sources;
+  std::vector<std::unique_ptr<Sink<D>>> sinks;
   std::unique_ptr<Damping<D>> damping;
   std::unique_ptr<Reference<D>> reference;
 
@@ -67,9 +73,11 @@ class Simulation {
   long step = 0;
   int threads = 1;
   int sort_every = 20;
+  long check_every = 1;           // numerics.check_every
   double mass_tolerance = 1e-12;  // nodes lighter than this (kg) get no velocity
   double max_speed = 0;           // largest particle speed, maintained by the scheme's gather
   int external_force = -1;        // particle field handle, or -1 if no load uses it
+  int deformation_gradient = -1;  // particle field handle, or -1 if nothing requested F
   bool model_checked = false;     // grid and plugins were set up (output checks may run)
   /// Set by a plugin that cannot continue (e.g. "particle 12: CPDI domain inverted"); the runner
   /// stops with exit code 3 after the current step, naming step and time.
@@ -130,14 +138,14 @@ class Simulation {
   }
   /// The material stress update of one block [b, b + count) (one material per block), with
   /// its velocity gradient L in block layout (MaterialBatch).
-  void update_block_stress(size_t b, int count, double dt, const double* L) {
+  void update_block_stress(ParticleSet<D>& set, size_t b, int count, double dt, const double* L) {
     MaterialBatch<D> batch;
     batch.begin = b;
     batch.count = count;
     batch.dt = dt;
     batch.L = L;
-    batch.particles = &particles;
-    materials[particles.material[b]]->update_stress(batch);
+    batch.particles = &set.particles;
+    materials[set.particles.material[b]]->update_stress(batch);
   }
   /// Face forces of the boundary conditions (GridForces), before the grid update.
   void apply_boundary_forces(const GridForces& f) const {
@@ -149,32 +157,74 @@ class Simulation {
   void apply_damping(const NodeForces& nf) {
     if (damping) damping->apply(*this, nf);
   }
+  /// f(set, begin, count, thread) over the blocks of every set: race-free scatters set after
+  /// set (one grid), gathers on all threads.
   template <class F>
-  void scatter_blocks(F&& f) const {
-    partition.scatter_blocks(std::forward<F>(f));
+  void scatter_blocks(F&& f) {
+    for (auto& s : sets) s.scatter_blocks([&](size_t b, int c, int t) { f(s, b, c, t); });
   }
   template <class F>
-  void gather_blocks(F&& f) const {
-    partition.gather_blocks(std::forward<F>(f));
+  void gather_blocks(F&& f) {
+    for (auto& s : sets) s.gather_blocks([&](size_t b, int c, int t) { f(s, b, c, t); });
   }
 
-  // --------------------------------------------------------- loop pieces (used by the runner)
+  // --------------------------------------------------------- particle fields
+  /// Register a particle field in every set (one layout: the handle is valid in each) and
+  /// allocate it in all of them, or only in set `only` (e.g. a material's state in the set of
+  /// its body). Plugins request fields here, never on one set's Particles directly.
+  int request_field(const FieldInfo& info, int only = -1);
+  /// The deformation gradient F (Particles::request_deformation_gradient) in every set.
+  int request_deformation_gradient();
+  /// Total particle count over all sets.
+  size_t num_particles() const;
+  /// Index of a set by name, or -1.
+  int set_index(const std::string& name) const;
+  /// The set of a body (index in the config's body list), and its particles.
+  int body_set(int body) const { return body_set_[size_t(body)]; }
+  Particles<D>& particles_of_body(int body) { return sets[size_t(body_set(body))].particles; }
+  const Particles<D>& particles_of_body(int body) const {
+    return sets[size_t(body_set(body))].particles;
+  }
+  /// The set a plugin names with `key` (absent: the scheme's first set), or -1 after a located
+  /// "unknown set" error listing the sets.
+  int set_param(const Params& p, const std::string& key, Diagnostics& diag) const;
+
+  // --------------------------------------------------------- sources and sinks
+  /// Create particles of a body at positions x with velocity v, in its set, with fresh ids
+  /// (never reused), initialised like the particles generated at t = 0 (volume and mass from the
+  /// body's spacing and density, then the shape function's, the scheme's and the material's
+  /// initialisation); counted in mass_created. The set is re-sorted before the next scatter.
+  void add_particles(int body, const std::vector<Vec>& x, const Vec& v);
+  /// Particle counts and masses that sources and sinks moved across the run's boundary: the mass
+  /// balance mass now + mass_removed - mass_created - initial_mass is round-off (the `mass`
+  /// field: the whole mass in one-phase schemes, the solid mass in two-phase ones).
+  size_t created = 0, removed = 0;
+  double mass_created = 0, mass_removed = 0, initial_mass = 0;
+  double total_mass() const;
+
+  // --------------------------------------------------------- the loop
+  /// One explicit step of length dt, as the runner and the tests take it: particle loads, the
+  /// shape function's per-step update, the scheme's step, time and step count, the stability
+  /// check of every set (every numerics.check_every steps, or now with `check`), the partition
+  /// of every set. Returns false, with Simulation::failure saying why, if the run cannot go on.
+  bool advance(double dt, bool check = false);
   double stable_dt() const;
   /// Zero and refill particle external forces from loads (only if a load uses them).
   void prepare_particle_loads();
-  /// Re-sort particles now.
+  /// Re-sort the particles of every set now.
   void sort();
-  /// After a step: keep the partition valid and sort periodically.
+  void sort(ParticleSet<D>& set);
+  /// After a step: keep every set's partition valid and sort periodically.
   void maintain_partition();
   /// Kinetic, stored and gravity energy and momentum of every particle set and phase: the
   /// particles' own (mass, velocity), the materials' strain energy, and the scheme's share
   /// (Scheme::add_energies: e.g. the pore water of a two-phase scheme).
   Energies energies() const;
 
-  /// Particle index of an original id (valid until the next sort).
-  size_t index_of(uint32_t id) const;
-  /// Ids of particles inside a named particle set; empty name = all. Returns false if unknown.
-  bool particle_set(const std::string& name, std::vector<uint32_t>& ids) const;
+  /// Ids of the particles of `set` inside a named selection box (`selections:`). Returns false
+  /// if no selection has that name.
+  bool selection(const std::string& name, const ParticleSet<D>& set,
+                 std::vector<uint32_t>& ids) const;
   int body_index(const std::string& name) const;
   /// The body a plugin names with `key` (the first body when the key is absent), or -1 after a
   /// located "unknown body" error listing the bodies.
@@ -183,17 +233,22 @@ class Simulation {
   /// First particle whose position, velocity or stress is not finite, or that left the grid:
   /// returns false and fills a description.
   bool check_particles(std::string& what) const;
+  bool check_particles(const ParticleSet<D>& set, std::string& what) const;
 
  private:
   void build_grid(const Params& g, Diagnostics& diag);
   void generate_bodies(Diagnostics& diag);
   void initialize_fields(Diagnostics& diag);  // bodies[].initial
   void create_plugins(Diagnostics& diag);
-  std::vector<std::pair<std::string, std::pair<Vec, Vec>>> sets_;
-  mutable std::vector<uint32_t> index_of_id_;
+  void create_sets(Diagnostics& diag);
+  void apply_sinks();
+  /// After a step: sinks remove, then sources create (at the new time).
+  void exchange_particles();
+  void check_sources_and_sinks(Diagnostics& diag);
+  uint32_t next_id_ = 0;
+  std::vector<int> body_set_;  // per config body, its set (0 after an error)
+  std::vector<std::pair<std::string, std::pair<Vec, Vec>>> selections_;
   mutable std::array<HeldComponents, 2> held_;  // per phase, scratch of constrain_update
-  mutable bool index_valid_ = false;
-  long last_sort_ = 0;
 };
 
 }  // namespace loam

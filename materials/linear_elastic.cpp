@@ -74,14 +74,16 @@ class LinearElastic : public Material<D> {
 
   double density() const override { return rho_; }
 
-  void setup(Simulation<D>& sim, int, Diagnostics&) override {
+  void setup(Simulation<D>& sim, int m, Diagnostics&) override {
     if (!hencky_) return;
-    auto& P = sim.particles;
-    F_ = P.request_deformation_gradient();
-    sigma0_ = P.request({"hencky_initial_stress", NS, "Pa",
-                         "initial Cauchy stress of the hencky formulation in the reference frame "
-                         "(sigma = tau_e / J + R sigma_0 R^T)",
-                         Particles<D>::stress_names()});
+    const int set = sim.body_set(m);  // state fields live in the set of the body
+    F_ = sim.request_deformation_gradient();
+    sigma0_ =
+        sim.request_field({"hencky_initial_stress", NS, "Pa",
+                           "initial Cauchy stress of the hencky formulation in the reference frame "
+                           "(sigma = tau_e / J + R sigma_0 R^T)",
+                           Particles<D>::stress_names()},
+                          set);
   }
 
   void initialize(Particles<D>& P, size_t b, size_t e) override {

@@ -202,19 +202,22 @@ class ModifiedCamClay : public Material<D> {
 
   double density() const override { return rho_; }
 
-  void setup(Simulation<D>& sim, int, Diagnostics&) override {
-    auto& P = sim.particles;
-    e_ = P.request({"void_ratio", 1, "-", "void ratio e (specific volume v = 1 + e)", {}});
-    pc_ = P.request({"preconsolidation_pressure",
-                     1,
-                     "Pa",
-                     "preconsolidation pressure p'_c (size of the Cam Clay yield ellipse)",
-                     {}});
-    eq_ = P.request({"plastic_strain_eq",
-                     1,
-                     "-",
-                     "equivalent plastic deviatoric strain sqrt(2/3 e:e), accumulated",
-                     {}});
+  void setup(Simulation<D>& sim, int m, Diagnostics&) override {
+    const int set = sim.body_set(m);  // state fields live in the set of the body
+    e_ = sim.request_field({"void_ratio", 1, "-", "void ratio e (specific volume v = 1 + e)", {}},
+                           set);
+    pc_ = sim.request_field({"preconsolidation_pressure",
+                             1,
+                             "Pa",
+                             "preconsolidation pressure p'_c (size of the Cam Clay yield ellipse)",
+                             {}},
+                            set);
+    eq_ = sim.request_field({"plastic_strain_eq",
+                             1,
+                             "-",
+                             "equivalent plastic deviatoric strain sqrt(2/3 e:e), accumulated",
+                             {}},
+                            set);
   }
 
   void initialize(Particles<D>& P, size_t b, size_t e) override {

@@ -129,12 +129,14 @@ class StrainSofteningMC : public Material<D> {
 
   double density() const override { return rho_; }
 
-  void setup(Simulation<D>& sim, int, Diagnostics&) override {
-    eq_ = sim.particles.request({"plastic_strain_eq",
-                                 1,
-                                 "-",
-                                 "equivalent plastic deviatoric strain sqrt(2/3 e:e), accumulated",
-                                 {}});
+  void setup(Simulation<D>& sim, int m, Diagnostics&) override {
+    const int set = sim.body_set(m);  // state fields live in the set of the body
+    eq_ = sim.request_field({"plastic_strain_eq",
+                             1,
+                             "-",
+                             "equivalent plastic deviatoric strain sqrt(2/3 e:e), accumulated",
+                             {}},
+                            set);
   }
 
   double wave_speed(const Particles<D>& P, size_t b, size_t e) const override {

@@ -28,9 +28,37 @@ class SinglePhase : public Scheme<D> {
              "grid update), usf (before forces)")
         .def("musl");
     add_flip_param(s);
+    s.string_list("sets",
+                  "names of the particle sets; all are summed onto the one velocity field (e.g. "
+                  "a column split into two sets behaves as one), each has its own output frames")
+        .def("[particles]");
+    s.check([](const Params& p, Diagnostics& d) {
+      const auto& names = p.strings("sets");
+      if (names.empty()) d.error(p.where("sets"), p.path("sets"), "give at least one set");
+      for (size_t i = 0; i < names.size(); ++i) {
+        const bool plain =
+            !names[i].empty() && std::all_of(names[i].begin(), names[i].end(), [](char c) {
+              return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+            });
+        if (!plain)
+          d.error(p.where("sets", i), p.path("sets") + "." + std::to_string(i),
+                  "a set name names its output files (<set>.xdmf): letters, digits, _ and - only");
+        for (size_t j = 0; j < i; ++j)
+          if (names[i] == names[j])
+            d.error(p.where("sets", i), p.path("sets") + "." + std::to_string(i),
+                    "duplicate set name '" + names[i] + "'");
+      }
+    });
     return s;
   }
-  explicit SinglePhase(const Params& p) : update_(p.text("update")), flip_(p.real("flip")) {}
+  explicit SinglePhase(const Params& p)
+      : update_(p.text("update")), flip_(p.real("flip")), sets_(p.strings("sets")) {}
+
+  std::vector<SetDeclaration> particle_sets() const override {
+    std::vector<SetDeclaration> s;
+    for (const auto& n : sets_) s.push_back({n, "material points on the one velocity field"});
+    return s;
+  }
 
   void setup(Simulation<D>& sim, Diagnostics&) override {
     node_.assign(sim.grid.num_nodes * S, 0.0);
@@ -50,7 +78,7 @@ class SinglePhase : public Scheme<D> {
 
   void step(Simulation<D>& sim, double dt) override {
     // Plugins may request F after this scheme's set-up; look it up once per step.
-    deformation_gradient_ = sim.particles.find("deformation_gradient");
+    deformation_gradient_ = sim.deformation_gradient;
     with_stencil_size<D>(sim.shape->nodes_per_particle(), [&](auto npp) {
       constexpr int NPP = decltype(npp)::value;
       if (update_ == "usf")
@@ -67,6 +95,7 @@ class SinglePhase : public Scheme<D> {
   static constexpr int NS = Particles<D>::NS;
   std::string update_;
   double flip_;
+  std::vector<std::string> sets_;
   int deformation_gradient_ = -1;
   std::vector<double> node_;  // num_nodes * S
   std::vector<double> vel_;   // num_nodes * D: velocity used for the velocity gradient
@@ -88,8 +117,8 @@ class SinglePhase : public Scheme<D> {
 
   /// Particle-to-grid: mass and momentum (MOMENTUM), internal, gravity and external forces (FORCE).
   template <int NPP, bool MOMENTUM, bool FORCE>
-  void scatter(Simulation<D>& sim, size_t b, int count, int thread) {
-    Particles<D>& P = sim.particles;
+  void scatter(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
+    Particles<D>& P = set.particles;
     StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
     sim.shape->evaluate(sim.grid, P, b, count, st);
     const int npp = NPP ? NPP : st.npp;
@@ -180,8 +209,9 @@ class SinglePhase : public Scheme<D> {
   /// Grid-to-particle velocity update (FLIP/PIC blend). With REMAP, scatter the new particle
   /// momentum into vel_ (MUSL). With MOVE, also move particles with the updated grid velocity.
   template <int NPP, bool REMAP, bool MOVE>
-  void update_velocity(Simulation<D>& sim, double dt, size_t b, int count, int thread) {
-    Particles<D>& P = sim.particles;
+  void update_velocity(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
+                       int thread) {
+    Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
     sim.shape->evaluate(sim.grid, P, b, count, st);
@@ -236,10 +266,11 @@ class SinglePhase : public Scheme<D> {
   /// Velocity gradient, volume update, optional move / velocity update, and the material's
   /// stress update for one block.
   template <int NPP, Gradient MODE>
-  void update_stress(Simulation<D>& sim, double dt, size_t b, int count, int thread) {
+  void update_stress(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
+                     int thread) {
     constexpr bool kMove = MODE != Gradient::kCurrent;
     constexpr bool kFromRecord = MODE == Gradient::kUpdated;
-    Particles<D>& P = sim.particles;
+    Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
     sim.shape->evaluate(sim.grid, P, b, count, st);
@@ -295,7 +326,7 @@ class SinglePhase : public Scheme<D> {
       }
     }
     sc.max_v2 = max_v2;
-    sim.update_block_stress(b, count, dt, L);
+    sim.update_block_stress(set, b, count, dt, L);
   }
 
   void reset_max_speed() {
@@ -311,7 +342,9 @@ class SinglePhase : public Scheme<D> {
   void step_usl_musl(Simulation<D>& sim, double dt, bool musl) {
     sim.timed("grid", [&] { zero(node_, sim.threads); });
     sim.timed("p2g", [&] {
-      sim.scatter_blocks([&](size_t b, int c, int t) { scatter<NPP, true, true>(sim, b, c, t); });
+      sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+        scatter<NPP, true, true>(sim, s, b, c, t);
+      });
     });
     sim.timed("grid", [&] { integrate(sim, dt); });
     reset_max_speed();
@@ -320,20 +353,21 @@ class SinglePhase : public Scheme<D> {
       // particles move with the grid velocity of the update (Sulsky 1995).
       sim.timed("grid", [&] { zero(vel_, sim.threads); });
       sim.timed("g2p_velocity_remap", [&] {
-        sim.scatter_blocks(
-            [&](size_t b, int c, int t) { update_velocity<NPP, true, false>(sim, dt, b, c, t); });
+        sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+          update_velocity<NPP, true, false>(sim, s, dt, b, c, t);
+        });
       });
       sim.timed("grid", [&] { momentum_to_velocity(sim, vel_.data(), D, 0); });
       sim.timed("g2p_gradient_stress", [&] {
-        sim.gather_blocks([&](size_t b, int c, int t) {
-          update_stress<NPP, Gradient::kRemapped>(sim, dt, b, c, t);
+        sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+          update_stress<NPP, Gradient::kRemapped>(sim, s, dt, b, c, t);
         });
       });
     } else {
       // USL: gradient, move and velocity update from the updated grid record in one pass.
       sim.timed("g2p_gradient_stress", [&] {
-        sim.gather_blocks([&](size_t b, int c, int t) {
-          update_stress<NPP, Gradient::kUpdated>(sim, dt, b, c, t);
+        sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+          update_stress<NPP, Gradient::kUpdated>(sim, s, dt, b, c, t);
         });
       });
     }
@@ -344,15 +378,21 @@ class SinglePhase : public Scheme<D> {
   void step_usf(Simulation<D>& sim, double dt) {
     // USF: stress from the velocity field at t^n, then forces, then the grid update.
     zero(node_, sim.threads);
-    sim.scatter_blocks([&](size_t b, int c, int t) { scatter<NPP, true, false>(sim, b, c, t); });
+    sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+      scatter<NPP, true, false>(sim, s, b, c, t);
+    });
     momentum_to_velocity(sim, node_.data(), S, 1);
-    sim.gather_blocks(
-        [&](size_t b, int c, int t) { update_stress<NPP, Gradient::kCurrent>(sim, dt, b, c, t); });
-    sim.scatter_blocks([&](size_t b, int c, int t) { scatter<NPP, false, true>(sim, b, c, t); });
+    sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+      update_stress<NPP, Gradient::kCurrent>(sim, s, dt, b, c, t);
+    });
+    sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+      scatter<NPP, false, true>(sim, s, b, c, t);
+    });
     integrate(sim, dt);
     reset_max_speed();
-    sim.gather_blocks(
-        [&](size_t b, int c, int t) { update_velocity<NPP, false, true>(sim, dt, b, c, t); });
+    sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+      update_velocity<NPP, false, true>(sim, s, dt, b, c, t);
+    });
     store_max_speed(sim);
   }
 };

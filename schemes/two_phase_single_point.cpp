@@ -103,19 +103,21 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         smooth_(p.text("pressure_smoothing") == "cell") {}
 
   int phases() const override { return 2; }
+  std::vector<SetDeclaration> particle_sets() const override {
+    return {{"particles", "points of the saturated mixture: the skeleton carrying its pore water"}};
+  }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    auto& P = sim.particles;
-    w_ = P.request({"water_velocity", D, "m/s", "pore water velocity", Particles<D>::axis_names()});
-    n_ = P.request({"porosity", 1, "-", "porosity (pore volume / total volume)", {}});
-    p_ = P.request(
+    w_ = sim.request_field(
+        {"water_velocity", D, "m/s", "pore water velocity", Particles<D>::axis_names()});
+    n_ = sim.request_field({"porosity", 1, "-", "porosity (pore volume / total volume)", {}});
+    p_ = sim.request_field(
         {"pore_pressure", 1, "Pa", "excess pore water pressure, compression positive", {}});
+    // One set, the mixture's points (the default declaration): the per-particle scratch below
+    // (dp_, move_, cell_index_) is indexed by its particles.
+    auto& P = sim.sets[0].particles;
     rho_w_ = drag_->water_density();
-    for (size_t i = 0; i < P.size(); ++i) {
-      P.col(n_)[i] = n0_;
-      P.col(P.mass)[i] *= 1 - n0_;  // solid mass: the material density is rho_s
-      for (int d = 0; d < D; ++d) P.col(w_, d)[i] = P.col(P.velocity, d)[i];
-    }
+    initialize_particles(sim, sim.sets[0], 0, P.size());
     drag_->setup(sim, diag);
     node_.assign(sim.grid.num_nodes * S, 0.0);
     solved_.assign(sim.grid.num_nodes * 2 * D, 0.0);
@@ -131,11 +133,22 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     });
   }
 
+  /// Porosity n0, solid mass (1 - n0) rho_s V (the material density is rho_s), water velocity
+  /// equal to the skeleton's.
+  void initialize_particles(Simulation<D>&, ParticleSet<D>& set, size_t b, size_t e) override {
+    auto& P = set.particles;
+    for (size_t i = b; i < e; ++i) {
+      P.col(n_)[i] = n0_;
+      P.col(P.mass)[i] *= 1 - n0_;
+      for (int d = 0; d < D; ++d) P.col(w_, d)[i] = P.col(P.velocity, d)[i];
+    }
+  }
+
   double stable_dt(const Simulation<D>& sim) const override {
-    const auto& P = sim.particles;
+    const auto& P = sim.sets[0].particles;
     double c2 = Kw_ / rho_w_;  // a water-only region: the water wave
     for (size_t m = 0; m < sim.materials.size(); ++m) {
-      const auto& r = sim.partition.material_ranges[m];
+      const auto& r = sim.sets[0].partition.material_ranges[m];
       if (r.end <= r.begin) continue;
       const double cd = sim.materials[m]->wave_speed(P, r.begin, r.end);
       for (size_t i = r.begin; i < r.end; ++i) {
@@ -166,7 +179,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// m_w = n rho_w V, its weight -m_w g . x, and its stored compression energy p^2 n V / (2 K_w)
   /// (p the excess pore pressure, Delta p = -K_w/n Delta(volumetric storage), eq. 15).
   void add_energies(const Simulation<D>& sim, Energies& e) const override {
-    const auto& P = sim.particles;
+    const auto& P = sim.sets[0].particles;
     const double* V = P.col(P.volume);
     const double* n = P.col(n_);
     const double* p = P.col(p_);
@@ -189,28 +202,35 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   }
 
   void step(Simulation<D>& sim, double dt) override {
-    F_ = sim.particles.find("deformation_gradient");  // may be requested after our set-up
+    F_ = sim.deformation_gradient;   // may be requested after our set-up
+    dp_.resize(sim.sets[0].size());  // the count changes with sources and sinks
     with_stencil_size<D>(sim.shape->nodes_per_particle(), [&](auto npp) {
       constexpr int NPP = decltype(npp)::value;
       sim.timed("grid", [&] { std::fill(node_.begin(), node_.end(), 0.0); });
       sim.timed("p2g", [&] {
-        sim.scatter_blocks([&](size_t b, int c, int t) { scatter<NPP>(sim, b, c, t); });
+        sim.scatter_blocks(
+            [&](ParticleSet<D>& s, size_t b, int c, int t) { scatter<NPP>(sim, s, b, c, t); });
       });
       sim.timed("grid", [&] { integrate(sim, dt); });
       for (auto& s : scratch_) s->max_v2 = 0;
       if (musl_) {
-        move_.resize(sim.particles.size() * D);
+        move_.resize(sim.sets[0].size() * D);  // the count changes with sources and sinks
         sim.timed("grid", [&] { std::fill(remap_.begin(), remap_.end(), 0.0); });
         sim.timed("g2p_velocity_remap", [&] {
-          sim.scatter_blocks([&](size_t b, int c, int t) { remap<NPP>(sim, dt, b, c, t); });
+          sim.scatter_blocks(
+              [&](ParticleSet<D>& s, size_t b, int c, int t) { remap<NPP>(sim, s, dt, b, c, t); });
         });
         sim.timed("grid", [&] { remapped_velocities(sim); });
         sim.timed("g2p_gradient_stress", [&] {
-          sim.gather_blocks([&](size_t b, int c, int t) { update<NPP, true>(sim, dt, b, c, t); });
+          sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+            update<NPP, true>(sim, s, dt, b, c, t);
+          });
         });
       } else {
         sim.timed("g2p_gradient_stress", [&] {
-          sim.gather_blocks([&](size_t b, int c, int t) { update<NPP, false>(sim, dt, b, c, t); });
+          sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+            update<NPP, false>(sim, s, dt, b, c, t);
+          });
         });
       }
       sim.timed("pore_pressure", [&] { apply_pressure_increment(sim); });
@@ -220,8 +240,9 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       for (auto& s : scratch_)
         if (s->bad_porosity >= 0) {
           const size_t i = size_t(s->bad_porosity);
-          sim.failure = "particle " + std::to_string(sim.particles.id[i]) +
-                        ": porosity left (0, 1) (n = " + format_number(sim.particles.col(n_)[i]) +
+          const auto& P = sim.sets[0].particles;
+          sim.failure = "particle " + std::to_string(P.id[i]) +
+                        ": porosity left (0, 1) (n = " + format_number(P.col(n_)[i]) +
                         "); the skeleton was compressed to zero pore volume or torn apart";
           s->bad_porosity = -1;
         }
@@ -268,7 +289,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// conserves the volume integral of p in each cell. Averaging only the increments is not
   /// enough: the checkerboard left by particles that change cells stays frozen (+-9 kPa).
   void apply_pressure_increment(Simulation<D>& sim) {
-    Particles<D>& P = sim.particles;
+    Particles<D>& P = sim.sets[0].particles;
     const long np = long(P.size());
     double* p = P.col(p_);
     if (!smooth_) {
@@ -287,7 +308,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     // A particle's cell lies inside its node stencil, so the race-free colouring of the
     // scatter covers the cell sums too.
     cell_index_.resize(P.size());
-    sim.scatter_blocks([&](size_t b, int count, int) {
+    sim.scatter_blocks([&](ParticleSet<D>&, size_t b, int count, int) {
       for (size_t i = b; i < b + size_t(count); ++i) {
         const size_t c = cell_of(i);
         cell_index_[i] = c;
@@ -304,8 +325,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   }
 
   template <int NPP>
-  void scatter(Simulation<D>& sim, size_t b, int count, int thread) {
-    Particles<D>& P = sim.particles;
+  void scatter(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
+    Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
     sim.shape->evaluate(sim.grid, P, b, count, st);
@@ -494,8 +515,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// re-mapped with the weights at x^n, so that a node without mass at x^n contributes zero
   /// velocity: a rigidly translating block then showed |p| up to 7.9e5 Pa.
   template <int NPP>
-  void remap(Simulation<D>& sim, double dt, size_t b, int count, int thread) {
-    Particles<D>& P = sim.particles;
+  void remap(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count, int thread) {
+    Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
     sim.shape->evaluate(sim.grid, P, b, count, st);
@@ -568,8 +589,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   }
 
   template <int NPP, bool REMAPPED>
-  void update(Simulation<D>& sim, double dt, size_t b, int count, int thread) {
-    Particles<D>& P = sim.particles;
+  void update(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count, int thread) {
+    Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
     sim.shape->evaluate(sim.grid, P, b, count, st);
@@ -621,7 +642,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       if (!(n > 0 && n < 1)) sc.bad_porosity = long(i);
     }
     sc.max_v2 = max_v2;
-    sim.update_block_stress(b, count, dt, L);
+    sim.update_block_stress(set, b, count, dt, L);
   }
 };
 

@@ -83,31 +83,37 @@ class Cpdi : public ShapeFunction<D> {
   int rows_above() const override { return reach_ + 1; }
 
   void setup(Simulation<D>& sim, Diagnostics&) override {
-    auto& P = sim.particles;
-    F_ = P.request_deformation_gradient();
-    half_ = P.request({"cpdi_half_spacing", D, "m",
-                       "CPDI: initial domain half-size per axis, r_i^0 = spacing_i / 2",
-                       Particles<D>::axis_names()});
+    F_ = sim.request_deformation_gradient();
+    half_ = sim.request_field({"cpdi_half_spacing", D, "m",
+                               "CPDI: initial domain half-size per axis, r_i^0 = spacing_i / 2",
+                               Particles<D>::axis_names()});
     std::vector<std::string> names;
     for (int d = 0; d < D; ++d)
       for (int i = 0; i < D; ++i) names.push_back(std::string(1, "xyz"[d]) + "123"[i]);
-    R_ = P.request({"cpdi_domain", D * D, "m",
-                    "CPDI domain vectors R = F diag(r^0): component d*D + i is coordinate d of r_i",
-                    names});
-    for (size_t i = 0; i < P.size(); ++i)
-      for (int d = 0; d < D; ++d)
-        P.col(half_, d)[i] = 0.5 * sim.bodies[P.body[i]].spacing[size_t(d)];
+    R_ = sim.request_field(
+        {"cpdi_domain", D * D, "m",
+         "CPDI domain vectors R = F diag(r^0): component d*D + i is coordinate d of r_i", names});
+    for (auto& set : sim.sets) initialize_particles(sim, set, 0, set.size());
     std::string unused;
     update_domains(sim, unused);  // R and the reach before the first sort
+  }
+
+  /// r^0 = spacing / 2 per axis (the domain vectors R follow in begin_step).
+  void initialize_particles(Simulation<D>& sim, ParticleSet<D>& set, size_t b, size_t e) override {
+    auto& P = set.particles;
+    for (size_t i = b; i < e; ++i)
+      for (int d = 0; d < D; ++d)
+        P.col(half_, d)[i] = 0.5 * sim.bodies[P.body[i]].spacing[size_t(d)];
   }
 
   void begin_step(Simulation<D>& sim) override {
     const int old_reach = reach_;
     update_domains(sim, sim.failure);
     // A larger reach may make the current slab colouring unsafe for this step's scatter.
-    if (reach_ > old_reach && sim.failure.empty() &&
-        !sim.partition.verify(sim.particles, sim.grid, rows_below(), rows_above()))
-      sim.sort();
+    if (reach_ > old_reach && sim.failure.empty())
+      for (auto& set : sim.sets)
+        if (!set.partition.verify(set.particles, sim.grid, rows_below(), rows_above()))
+          sim.sort(set);
   }
 
   void evaluate(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
@@ -241,11 +247,23 @@ class Cpdi : public ShapeFunction<D> {
     }
   }
 
-  /// R = F diag(r^0) for every particle, the checks, and the reach. Writes a message naming the
-  /// first bad particle into `failure` (left untouched when all domains are fine).
+  /// R = F diag(r^0) for every particle of every set, the checks, and the reach. Writes a
+  /// message naming the first bad particle into `failure` (left untouched when all domains are
+  /// fine).
   void update_domains(Simulation<D>& sim, std::string& failure) {
-    auto& P = sim.particles;
+    double max_extent = 0;  // along the last axis
+    for (auto& set : sim.sets)
+      if (failure.empty()) update_domains(sim, set.particles, failure, max_extent);
+    // Rows: a corner lies within max_extent of the particle along the last axis, so its cell row
+    // differs from the particle's by at most floor(max_extent / h) + 1 (one more than ceil when
+    // the ratio is an integer, against round-off); its tent functions reach one row further up.
+    reach_ = int(std::floor(max_extent * sim.grid.inv_cell[D - 1])) + 1;
+  }
+
+  void update_domains(Simulation<D>& sim, Particles<D>& P, std::string& failure,
+                      double& largest_extent) {
     const auto& g = sim.grid;
+    double max_extent = largest_extent;
     const size_t n = P.size();
     const double* Fc[D * D];
     double* Rc[D * D];
@@ -259,8 +277,7 @@ class Cpdi : public ShapeFunction<D> {
       hi[d] = g.upper(d) + slack;
     }
     const double s2 = max_stretch_ * max_stretch_, jmin = min_jacobian_;
-    double max_extent = 0;  // along the last axis
-    size_t suspect = n;     // first particle failing a cheap (sufficient) test
+    size_t suspect = n;  // first particle failing a cheap (sufficient) test
 #pragma omp parallel for schedule(static) num_threads(sim.threads) if (n >= kParallelMin) \
     reduction(max                                                                         \
               : max_extent) reduction(min                                                 \
@@ -282,10 +299,7 @@ class Cpdi : public ShapeFunction<D> {
       }
       if (!ok) suspect = std::min(suspect, i);
     }
-    // Rows: a corner lies within max_extent of the particle along the last axis, so its cell row
-    // differs from the particle's by at most floor(max_extent / h) + 1 (one more than ceil when
-    // the ratio is an integer, against round-off); its tent functions reach one row further up.
-    reach_ = int(std::floor(max_extent * g.inv_cell[D - 1])) + 1;
+    largest_extent = max_extent;
     if (suspect == n) return;
     // Exact checks from the first suspect on (the Frobenius test is only sufficient).
     size_t bad = n;
@@ -294,9 +308,9 @@ class Cpdi : public ShapeFunction<D> {
                                                                         : bad)
     for (size_t i = suspect; i < n; ++i) {
       int axis = 0;
-      if (check(sim, i, axis) != Problem::kNone) bad = std::min(bad, i);
+      if (check(sim, P, i, axis) != Problem::kNone) bad = std::min(bad, i);
     }
-    if (bad < n) failure = message(sim, bad);
+    if (bad < n) failure = message(sim, P, bad);
   }
 
   static std::string num(double v) {  // 6 significant digits are enough for a message
@@ -308,8 +322,7 @@ class Cpdi : public ShapeFunction<D> {
   enum class Problem { kNone, kInverted, kStretched, kOutside };
 
   /// Exact check of particle i's domain; `axis` is set for kOutside.
-  Problem check(const Simulation<D>& sim, size_t i, int& axis) const {
-    const auto& P = sim.particles;
+  Problem check(const Simulation<D>& sim, const Particles<D>& P, size_t i, int& axis) const {
     const auto& g = sim.grid;
     double f[D][D];
     for (int d = 0; d < D; ++d)
@@ -329,11 +342,10 @@ class Cpdi : public ShapeFunction<D> {
   }
 
   /// The message for a particle whose check failed.
-  std::string message(const Simulation<D>& sim, size_t i) const {
-    const auto& P = sim.particles;
+  std::string message(const Simulation<D>& sim, const Particles<D>& P, size_t i) const {
     const auto& g = sim.grid;
     int d = 0;
-    const Problem what = check(sim, i, d);
+    const Problem what = check(sim, P, i, d);
     double f[D][D];
     for (int a = 0; a < D; ++a)
       for (int j = 0; j < D; ++j) f[a][j] = P.col(F_, a * D + j)[i];

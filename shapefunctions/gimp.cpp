@@ -82,36 +82,48 @@ class Gimp : public ShapeFunction<D> {
   int rows_above() const override { return 2; }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    Particles<D>& P = sim.particles;
-    half_width_ = P.request(
-        {"gimp_half_width", D, "m", "GIMP particle-domain half-width lp per axis", P.axis_names()});
+    const auto axes = Particles<D>::axis_names();
+    half_width_ = sim.request_field(
+        {"gimp_half_width", D, "m", "GIMP particle-domain half-width lp per axis", axes});
     if (stretch_) {
-      half_width0_ =
-          P.request({"gimp_half_width0", D, "m", "initial GIMP particle-domain half-width per axis",
-                     P.axis_names()});
-      deformation_gradient_ = P.request_deformation_gradient();
+      half_width0_ = sim.request_field(
+          {"gimp_half_width0", D, "m", "initial GIMP particle-domain half-width per axis", axes});
+      deformation_gradient_ = sim.request_deformation_gradient();
     }
-    for (int d = 0; d < D; ++d) {
-      double* lp = P.col(half_width_, d);
-      double* lp0 = stretch_ ? P.col(half_width0_, d) : nullptr;
-      const double h = sim.grid.cell[size_t(d)];
-      for (size_t i = 0; i < P.size(); ++i) {
-        lp[i] = 0.5 * sim.bodies[P.body[i]].spacing[size_t(d)];
-        if (lp0) lp0[i] = lp[i];
-        if (!stretch_ && lp[i] > 0.5 * h * (1 + 1e-12)) {
+    // uGIMP (no stretch) needs lp <= h / 2: at least one particle per cell.
+    for (const Body& body : sim.bodies)
+      for (int d = 0; d < D && !stretch_; ++d)
+        if (0.5 * body.spacing[size_t(d)] > 0.5 * sim.grid.cell[size_t(d)] * (1 + 1e-12)) {
           diag.error(sim.config.where("shape_function"), "shape_function",
-                     "gimp: body '" + sim.bodies[P.body[i]].name +
+                     "gimp: body '" + body.name +
                          "' has a particle spacing larger than the cell size; uGIMP needs at "
                          "least one particle per cell");
           return;
         }
+    for (auto& set : sim.sets) initialize_particles(sim, set, 0, set.size());
+  }
+
+  /// lp = lp0 = spacing / 2 per axis.
+  void initialize_particles(Simulation<D>& sim, ParticleSet<D>& set, size_t b, size_t e) override {
+    Particles<D>& P = set.particles;
+    for (int d = 0; d < D; ++d) {
+      double* lp = P.col(half_width_, d);
+      double* lp0 = stretch_ ? P.col(half_width0_, d) : nullptr;
+      for (size_t i = b; i < e; ++i) {
+        lp[i] = 0.5 * sim.bodies[P.body[i]].spacing[size_t(d)];
+        if (lp0) lp0[i] = lp[i];
       }
     }
   }
 
   void begin_step(Simulation<D>& sim) override {
     if (!stretch_) return;
-    Particles<D>& P = sim.particles;
+    for (auto& set : sim.sets)
+      if (sim.failure.empty()) stretch_domains(sim, set.particles);
+  }
+
+  /// domain_update: stretch: lp = lp0 F_dd, capped at one cell.
+  void stretch_domains(Simulation<D>& sim, Particles<D>& P) {
     const long n = long(P.size());
     long first_bad = n, first_capped = n, capped = 0;
     std::array<const double*, D> F{}, lp0{};

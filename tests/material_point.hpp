@@ -50,21 +50,21 @@ struct MaterialPoint {
     batch.begin = 0;
     batch.count = 1;
     batch.L = L.data();
-    batch.particles = &sim->particles;
+    batch.particles = &sim->sets[0].particles;
     batch.dt = 1.0;
   }
 
   /// Handle of a particle field; throws if no plugin requested it.
   int handle(const std::string& name) const {
-    const int h = sim->particles.find(name);
+    const int h = sim->sets[0].particles.find(name);
     if (h < 0) throw std::runtime_error("no particle field '" + name + "'");
     return h;
   }
-  double& field(int handle, int c = 0) { return sim->particles.col(handle, c)[0]; }
+  double& field(int handle, int c = 0) { return sim->sets[0].particles.col(handle, c)[0]; }
   double& field(const std::string& name, int c = 0) { return field(handle(name), c); }
-  double& stress(int c) { return field(sim->particles.stress, c); }
-  double& volume() { return field(sim->particles.volume); }
-  double mass() { return field(sim->particles.mass); }
+  double& stress(int c) { return field(sim->sets[0].particles.stress, c); }
+  double& volume() { return field(sim->sets[0].particles.volume); }
+  double mass() { return field(sim->sets[0].particles.mass); }
   double rho() { return mass() / volume(); }
 
   /// sigma = s I (tension positive).
@@ -98,8 +98,8 @@ struct MaterialPoint {
   }
 
   /// Every component of every particle field of the point, in field order.
-  std::vector<double> save() const { return sim->particles.state_of(0); }
-  void restore(const std::vector<double>& s) { sim->particles.restore_state(0, s); }
+  std::vector<double> save() const { return sim->sets[0].particles.state_of(0); }
+  void restore(const std::vector<double>& s) { sim->sets[0].particles.restore_state(0, s); }
 
   /// Mean pressure, compression positive.
   double p() { return -(stress(0) + stress(1) + stress(2)) / 3; }
@@ -123,9 +123,9 @@ struct MaterialPoint {
   }
 
   double wave_speed() {
-    return sim->materials[0]->wave_speed(sim->particles, 0, sim->particles.size());
+    return sim->materials[0]->wave_speed(sim->sets[0].particles, 0, sim->sets[0].particles.size());
   }
-  double strain_energy() { return sim->materials[0]->strain_energy(sim->particles, 0, 1); }
+  double strain_energy() { return sim->materials[0]->strain_energy(sim->sets[0].particles, 0, 1); }
 
   /// One drained increment along x: axial strain -da and equal lateral normal strains e (y and,
   /// in 3D, z; 2D is plane strain, zz fixed), e found by a secant iteration from nu da and

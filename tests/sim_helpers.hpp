@@ -24,19 +24,12 @@ std::unique_ptr<loam::Simulation<D>> make_simulation(const std::string& yaml, in
   return sim;
 }
 
-/// Advance n steps with the scheme (no output), as the runner does.
+/// Advance n steps at the stable time step with Simulation::advance, the runner's step (with its
+/// stability checks; no output). Throws with the failure message if the run cannot go on.
 template <int D>
 void advance(loam::Simulation<D>& sim, int steps) {
-  for (int i = 0; i < steps; ++i) {
-    sim.dt = sim.stable_dt();
-    sim.prepare_particle_loads();
-    sim.shape->begin_step(sim);
-    if (!sim.failure.empty()) throw std::runtime_error(sim.failure);
-    sim.scheme->step(sim, sim.dt);
-    sim.time += sim.dt;
-    ++sim.step;
-    sim.maintain_partition();
-  }
+  for (int i = 0; i < steps; ++i)
+    if (!sim.advance(sim.stable_dt())) throw std::runtime_error(sim.failure);
 }
 
 /// A reference plugin from its `verify:` YAML text, set up on `sim` (REQUIREs no errors).

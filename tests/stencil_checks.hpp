@@ -30,7 +30,7 @@ struct StencilErrors {
 /// components (must be 0).
 template <int D>
 StencilErrors stencil_consistency(loam::Simulation<D>& sim) {
-  auto& P = sim.particles;
+  auto& P = sim.sets[0].particles;
   const auto& g = sim.grid;
   loam::StencilBlock<D> st;
   st.allocate(sim.shape->nodes_per_particle());
@@ -85,7 +85,7 @@ template <int D>
 NodeValues<D> node_values(loam::Simulation<D>& sim, size_t particle) {
   loam::StencilBlock<D> st;
   st.allocate(sim.shape->nodes_per_particle());
-  sim.shape->evaluate(sim.grid, sim.particles, particle, 1, st);
+  sim.shape->evaluate(sim.grid, sim.sets[0].particles, particle, 1, st);
   NodeValues<D> out;
   for (int k = 0; k < st.npp; ++k) {
     const size_t kp = size_t(k) * loam::kBlock;

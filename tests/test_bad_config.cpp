@@ -106,8 +106,8 @@ void require_rejected(const Scratch& s, const Outcome& r, const std::vector<std:
 }
 
 const std::string kTopKeys =
-    "plugins, grid, shape_function, scheme, gravity, bodies, particle_sets, boundaries, loads, "
-    "damping, time, output, probes, verify, numerics";
+    "plugins, grid, shape_function, scheme, gravity, bodies, selections, boundaries, loads, "
+    "sources, sinks, damping, time, output, probes, verify, numerics";
 
 }  // namespace
 
@@ -167,7 +167,7 @@ time:
       {s.error_at(5, 5, "bodies.0.material",
                   "missing required key 'material' (constitutive model of the body)"),
        s.error_at(7, 5, "bodies.0.materal",
-                  "unknown key 'materal'; did you mean 'material'? valid keys are: name, "
+                  "unknown key 'materal'; did you mean 'material'? valid keys are: name, set, "
                   "generator, particles_per_cell, material, velocity, stress, initial")});
 }
 

@@ -40,7 +40,7 @@ std::string cpdi_scene(const std::string& shape = "cpdi") {
 /// Write the same F (row-major) into every particle's deformation gradient.
 template <int D>
 void set_F(loam::Simulation<D>& sim, const std::array<double, D * D>& F) {
-  auto& P = sim.particles;
+  auto& P = sim.sets[0].particles;
   const int h = P.find("deformation_gradient");
   REQUIRE(h >= 0);
   for (int c = 0; c < D * D; ++c) std::fill(P.col(h, c), P.col(h, c) + P.size(), F[size_t(c)]);
@@ -49,7 +49,7 @@ void set_F(loam::Simulation<D>& sim, const std::array<double, D * D>& F) {
 /// Random positions in [lo, hi]^D for every particle.
 template <int D>
 void scatter_positions(loam::Simulation<D>& sim, double lo, double hi, unsigned seed) {
-  auto& P = sim.particles;
+  auto& P = sim.sets[0].particles;
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(lo, hi);
   for (size_t i = 0; i < P.size(); ++i)
@@ -62,7 +62,7 @@ void check_consistency(loam::Simulation<D>& sim, const std::string& label) {
   std::printf(
       "cpdi %dD %-22s: max |sum N - 1| %.2e, h max |sum grad N| %.2e, max |sum N x_I - x_p|/h "
       "%.2e, max |sum x_I grad N - I| %.2e (%zu particles)\n",
-      D, label.c_str(), e.sum, e.grad, e.repro, e.grad_repro, sim.particles.size());
+      D, label.c_str(), e.sum, e.grad, e.repro, e.grad_repro, sim.sets[0].particles.size());
   CHECK(e.sum < 1e-13);
   CHECK(e.grad < 1e-12);
   CHECK(e.repro < 1e-12);
@@ -151,7 +151,7 @@ TEST_CASE("cpdi: weights and gradients match the paper's corner formulas (1D, 2D
   {
     auto sim = make_simulation<1>(cpdi_scene<1>());
     set_F<1>(*sim, {2.6});
-    auto& P = sim->particles;
+    auto& P = sim->sets[0].particles;
     P.col(P.position)[0] = 0.437;
     sim->shape->begin_step(*sim);
     REQUIRE(sim->failure.empty());
@@ -176,7 +176,7 @@ TEST_CASE("cpdi: weights and gradients match the paper's corner formulas (1D, 2D
                  std::array<double, 4>{0.8, 1.5, -0.6, 1.2}}) {
     auto sim = make_simulation<2>(cpdi_scene<2>());
     set_F<2>(*sim, F);
-    auto& P = sim->particles;
+    auto& P = sim->sets[0].particles;
     const double h0 = 0.025;
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> u(0.3, 0.7);
@@ -184,11 +184,11 @@ TEST_CASE("cpdi: weights and gradients match the paper's corner formulas (1D, 2D
     size_t nodes = 0;
     for (int trial = 0; trial < 50; ++trial) {
       const double x = u(rng), y = u(rng);
-      size_t i = sim->index_of(0);
+      size_t i = sim->sets[0].index_of(0);
       P.col(P.position, 0)[i] = x, P.col(P.position, 1)[i] = y;
       sim->shape->begin_step(*sim);  // may re-sort when the reach grows
       REQUIRE(sim->failure.empty());
-      i = sim->index_of(0);
+      i = sim->sets[0].index_of(0);
       REQUIRE(P.col(P.position, 0)[i] == x);
       const double r1x = F[0] * h0, r1y = F[2] * h0, r2x = F[1] * h0, r2y = F[3] * h0;
       const double V = 4 * (r1x * r2y - r1y * r2x);
@@ -219,7 +219,7 @@ TEST_CASE("cpdi: weights and gradients match the paper's corner formulas (1D, 2D
 
 TEST_CASE("cpdi: reported row reach bounds every touched node row", "[shape][unit]") {
   auto sim = make_simulation<2>(cpdi_scene<2>("{type: cpdi, max_stretch: 10}"));
-  auto& P = sim->particles;
+  auto& P = sim->sets[0].particles;
   const auto& g = sim->grid;
   // Undeformed, 2 particles per cell: corners within h/4 of the particle, one row either way.
   CHECK(sim->shape->rows_below() == 1);
@@ -270,11 +270,11 @@ TEST_CASE("cpdi: a grown reach re-sorts the slab colouring when it is no longer 
       "    particles_per_cell: 2\n"
       "    material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 1000}\ntime: {end: 1}\n";
   auto sim = make_simulation<2>(yaml, 2);
-  auto& P = sim->particles;
-  const size_t slabs_before = sim->partition.slabs.size();
-  REQUIRE(sim->partition.verify(P, sim->grid, 1, 2));
+  auto& P = sim->sets[0].particles;
+  const size_t slabs_before = sim->sets[0].partition.slabs.size();
+  REQUIRE(sim->sets[0].partition.verify(P, sim->grid, 1, 2));
   set_F<2>(*sim, {1, 0, 0, 9});
-  const bool safe_without_resort = sim->partition.verify(P, sim->grid, 3, 4);
+  const bool safe_without_resort = sim->sets[0].partition.verify(P, sim->grid, 3, 4);
   sim->shape->begin_step(*sim);
   REQUIRE(sim->failure.empty());
   CHECK(sim->shape->rows_below() == 3);
@@ -282,9 +282,9 @@ TEST_CASE("cpdi: a grown reach re-sorts the slab colouring when it is no longer 
   std::printf(
       "cpdi reach 1+2 -> 3+4 rows: %zu slabs before, colouring safe without re-sort: %s, %zu "
       "slabs after\n",
-      slabs_before, safe_without_resort ? "yes" : "no", sim->partition.slabs.size());
+      slabs_before, safe_without_resort ? "yes" : "no", sim->sets[0].partition.slabs.size());
   CHECK_FALSE(safe_without_resort);  // the test is meaningful
-  CHECK(sim->partition.verify(P, sim->grid, sim->shape->rows_below(), sim->shape->rows_above()));
+  CHECK(sim->sets[0].partition.verify(P, sim->grid, sim->shape->rows_below(), sim->shape->rows_above()));
   // And the step itself runs (scatter, gather, F update) with the stretched domains.
   CHECK_NOTHROW(advance(*sim, 2));
 }
@@ -294,9 +294,9 @@ TEST_CASE("cpdi stops with a clear message: inverted, too stretched, corner outs
   const uint32_t id = 17;
   SECTION("det F <= 0 (inverted domain)") {
     auto sim = make_simulation<2>(cpdi_scene<2>());
-    auto& P = sim->particles;
+    auto& P = sim->sets[0].particles;
     const int F = P.find("deformation_gradient");
-    const size_t i = sim->index_of(id);
+    const size_t i = sim->sets[0].index_of(id);
     P.col(F, 0)[i] = -0.5;  // F = diag(-0.5, 1)
     try {
       advance(*sim, 1);
@@ -312,16 +312,16 @@ TEST_CASE("cpdi stops with a clear message: inverted, too stretched, corner outs
   }
   SECTION("det F = 0 (degenerate domain)") {
     auto sim = make_simulation<1>(cpdi_scene<1>());
-    auto& P = sim->particles;
-    P.col(P.find("deformation_gradient"))[sim->index_of(3)] = 0.0;
+    auto& P = sim->sets[0].particles;
+    P.col(P.find("deformation_gradient"))[sim->sets[0].index_of(3)] = 0.0;
     REQUIRE_THROWS_WITH(advance(*sim, 1), Contains("particle 3 of body 'block'") &&
                                               Contains("inverted or degenerate (det F = 0"));
   }
   SECTION("largest principal stretch above max_stretch (2D, 3D)") {
     auto sim = make_simulation<2>(cpdi_scene<2>());
-    auto& P = sim->particles;
+    auto& P = sim->sets[0].particles;
     const int F = P.find("deformation_gradient");
-    const size_t i = sim->index_of(id);
+    const size_t i = sim->sets[0].index_of(id);
     P.col(F, 1)[i] = 4.0;  // shear [[1, 4], [0, 1]]: largest stretch 4.236 > 4
     try {
       advance(*sim, 1);
@@ -348,8 +348,8 @@ TEST_CASE("cpdi stops with a clear message: inverted, too stretched, corner outs
   }
   SECTION("a corner leaves the grid") {
     auto sim = make_simulation<2>(cpdi_scene<2>());
-    auto& P = sim->particles;
-    const size_t i = sim->index_of(id);
+    auto& P = sim->sets[0].particles;
+    const size_t i = sim->sets[0].index_of(id);
     P.col(P.position, 0)[i] = 0.01;  // domain [-0.015, 0.035]: 0.15 cells outside (> 0.1)
     try {
       advance(*sim, 1);
@@ -363,7 +363,7 @@ TEST_CASE("cpdi stops with a clear message: inverted, too stretched, corner outs
     }
     // Within the allowed overhang (round-off drift at a grid face) the run goes on.
     auto ok = make_simulation<2>(cpdi_scene<2>());
-    ok->particles.col(ok->particles.position, 0)[ok->index_of(id)] = 0.02;
+    ok->sets[0].particles.col(ok->sets[0].particles.position, 0)[ok->sets[0].index_of(id)] = 0.02;
     CHECK_NOTHROW(advance(*ok, 1));
   }
 }

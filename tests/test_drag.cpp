@@ -214,7 +214,7 @@ TEST_CASE("ergun: a batch equals point-by-point evaluation", "[drag][unit]") {
 }
 
 TEST_CASE("darcy: bad parameters give the located error", "[drag][unit]") {
-  // Reference: the standard FILE:LINE:COL: error: path: message (DESIGN.md), one line each.
+  // Reference: the standard FILE:LINE:COL: error: path: message (docs/architecture.md "Errors"), one line each.
   struct Case {
     std::string yaml, error;
   };
@@ -245,7 +245,7 @@ TEST_CASE("darcy: bad parameters give the located error", "[drag][unit]") {
 }
 
 TEST_CASE("ergun: bad parameters give the located error", "[drag][unit]") {
-  // Reference: the standard FILE:LINE:COL: error: path: message (DESIGN.md), one line each.
+  // Reference: the standard FILE:LINE:COL: error: path: message (docs/architecture.md "Errors"), one line each.
   struct Case {
     std::string yaml, error;
   };

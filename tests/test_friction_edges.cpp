@@ -238,7 +238,7 @@ std::pair<double, double> slide(const std::string& wall, bool wall_first) {
       (wall_first ? side + base : base + side) + "time: {end: 1}\n";
   auto sim = loam_test::make_simulation<3>(yaml);
   while (sim->time < 0.1) loam_test::advance(*sim, 1);
-  const auto& P = sim->particles;
+  const auto& P = sim->sets[0].particles;
   double mv = 0, m = 0;
   for (size_t i = 0; i < P.size(); ++i) {
     mv += P.col(P.mass)[i] * P.col(P.velocity, 1)[i];

@@ -118,7 +118,7 @@ TEST_CASE("friction boundary: a block sliding on the base decelerates at mu g",
     Run r;
     while (sim->time < 0.1) {
       loam_test::advance(*sim, 1);
-      const auto& P = sim->particles;
+      const auto& P = sim->sets[0].particles;
       double mx = 0, my = 0, m = 0;
       for (size_t i = 0; i < P.size(); ++i) {
         mx += P.col(P.mass)[i] * P.col(P.velocity, 0)[i];

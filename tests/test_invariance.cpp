@@ -55,7 +55,7 @@ struct Worst {
 
 template <int D>
 Worst worst_deviation(loam::Simulation<D>& sim, const std::array<double, 3>& v0) {
-  auto& P = sim.particles;
+  auto& P = sim.sets[0].particles;
   Worst w;
   const int p = P.find("pore_pressure");
   for (size_t i = 0; i < P.size(); ++i) {
@@ -160,7 +160,7 @@ TEST_CASE("rigid spin: no strain rate in the interior, every scheme and shape fu
           "    material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2650}\n"
           "time: {end: 1}\n";
       auto sim = loam_test::make_simulation<2>(cfg);
-      auto& P = sim->particles;
+      auto& P = sim->sets[0].particles;
       const int w = P.find("water_velocity");
       for (size_t i = 0; i < P.size(); ++i) {
         const double x = P.col(P.position, 0)[i] - 1.0, y = P.col(P.position, 1)[i] - 1.0;

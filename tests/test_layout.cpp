@@ -1,5 +1,5 @@
 // The core names no concrete plugin: framework/ includes nothing from the plugin directories and
-// no framework source spells a registered plugin's name as a string literal (DESIGN.md).
+// no framework source spells a registered plugin's name as a string literal (docs/architecture.md).
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
@@ -83,7 +83,8 @@ TEST_CASE("every built-in plugin is one file named as its YAML type, in its kind
       {"load", "plugins/loads"},          {"damping", "plugins/damping"},
       {"drag", "plugins/drag"},           {"generator", "plugins/generators"},
       {"field", "plugins/fields"},        {"reference", "plugins/references"},
-      {"writer", "plugins/writers"}};
+      {"writer", "plugins/writers"},      {"source", "plugins/sources"},
+      {"sink", "plugins/sinks"}};
   auto& reg = loam::Registry::instance();
   int checked = 0;
   for (const auto& k : reg.kinds()) {

@@ -59,12 +59,12 @@ struct Point {
     batch.begin = 0;
     batch.count = 1;
     batch.L = L.data();
-    batch.particles = &sim->particles;
+    batch.particles = &sim->sets[0].particles;
     batch.dt = 1.0;
     V0 = volume();
   }
   loam::Material<D>& mat() { return *sim->materials[0]; }
-  loam::Particles<D>& P() { return sim->particles; }
+  loam::Particles<D>& P() { return sim->sets[0].particles; }
   double& stress(int c) { return P().col(P().stress, c)[0]; }
   double& volume() { return P().col(P().volume)[0]; }
   /// Full 3x3 Cauchy stress.

@@ -82,7 +82,7 @@ struct Point : loam_test::MaterialPoint<D> {
   /// Impose a stress (tension positive Voigt, NS components) and re-initialize the state.
   void set(const std::vector<double>& s) {
     for (int k = 0; k < Point::NS; ++k) this->stress(k) = s[size_t(k)];
-    this->sim->materials[0]->initialize(this->sim->particles, 0, 1);
+    this->sim->materials[0]->initialize(this->sim->sets[0].particles, 0, 1);
   }
   double f_rel() {
     const double p = this->p(), q = this->q();
@@ -488,7 +488,7 @@ TEST_CASE("modified_cam_clay: initial state, min_pressure and wave speed", "[mat
   Point<3> a(mcc(", ocr: 2, min_pressure: 1000"));
   a.set({-150e3, -75e3, -75e3, 0, 0, 0});  // p' = 100 kPa, q = 75 kPa
   const double pc_a = std::max(2 * 100e3, 100e3 + 75e3 * 75e3 / (kM * kM * 100e3));
-  auto& P = a.sim->particles;
+  auto& P = a.sim->sets[0].particles;
   const double rho = P.col(P.mass)[0] / P.col(P.volume)[0];
   const double K = (1 + kE0) * (100e3 + 1000) / kKappa;
   const double G = 1.5 * K * (1 - 2 * kNu) / (1 + kNu);

@@ -298,7 +298,7 @@ TEST_CASE("newtonian_fluid: a water column under gravity settles to hydrostatic 
       "damping: {type: local, alpha: 0.3}\n"
       "time: {end: 1.0, cfl: 0.5}\n";
   auto sim = make_simulation<2>(cfg);
-  auto& P = sim->particles;
+  auto& P = sim->sets[0].particles;
   std::vector<int> row(P.size());
   for (size_t i = 0; i < P.size(); ++i) row[i] = int(P.col(P.position, 1)[i] / 0.05);
   while (sim->time < 1.0) loam_test::advance(*sim, 1);

@@ -1,4 +1,4 @@
-// Out-of-tree plugins (DESIGN.md "The plugin contract"): the example library built from
+// Out-of-tree plugins (docs/architecture.md "Plugins"): the example library built from
 // plugins/examples/ is loaded by a run file's `plugins:` list and runs through the real command
 // line; a missing library and a library without the ABI symbol are input errors (exit 2).
 #include <sys/wait.h>

@@ -185,7 +185,7 @@ TEST_CASE("every configured plugin is applied by every scheme and update variant
     for (auto& m : sim->materials) m = std::make_unique<CountingMaterial<2>>(std::move(m), c);
     for (auto& b : sim->boundaries) b = std::make_unique<CountingBoundary<2>>(std::move(b), c);
     loam_test::advance(*sim, steps);
-    const long blocks = long((sim->particles.size() + loam::kBlock - 1) / loam::kBlock);
+    const long blocks = long((sim->sets[0].particles.size() + loam::kBlock - 1) / loam::kBlock);
     std::printf(
         "%-28s: %d steps: damping %ld, particle loads %ld, grid loads %ld, boundary grid "
         "updates %ld, force hooks %ld, re-mapped constraints %ld, stress batches %ld (%ld "

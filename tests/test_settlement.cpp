@@ -44,7 +44,7 @@ void check_settlement() {
   // components -1e6 must not count. One pore pressure of -500 Pa and the cap's 1e6 Pa (another
   // body) -> max |p| / load = 500 / 1e4 = 0.05.
   auto sim = loam_test::make_simulation<D>(scene<D>());
-  auto& P = sim->particles;
+  auto& P = sim->sets[0].particles;
   const int pore = P.request({"pore_pressure", 1, "Pa", "excess pore pressure", {}});
   auto ref = loam_test::make_reference<D>(*sim,
                                           "{type: settlement, body: column, load: 1.0e4, "

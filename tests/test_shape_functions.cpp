@@ -40,7 +40,7 @@ using loam_test::NodeValues;
 template <int D>
 NodeValues<D> evaluate_at(loam::Simulation<D>& sim, const std::array<double, D>& x,
                           size_t particle = 0) {
-  for (int d = 0; d < D; ++d) sim.particles.col(sim.particles.position, d)[particle] = x[size_t(d)];
+  for (int d = 0; d < D; ++d) sim.sets[0].particles.col(sim.sets[0].particles.position, d)[particle] = x[size_t(d)];
   return loam_test::node_values(sim, particle);
 }
 
@@ -49,7 +49,7 @@ template <int D>
 void check_random_consistency(const std::string& shape, double lo, double hi,
                               const std::string& label, unsigned seed = 11) {
   auto sim = make_simulation<D>(scene<D>(shape));
-  auto& P = sim->particles;
+  auto& P = sim->sets[0].particles;
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(lo, hi);
   // At least ~1500 random positions per dimension (the 1D block has only 12 particles).
@@ -171,7 +171,7 @@ TEST_CASE("gimp with stretched domains (lp up to one cell): consistency in 1D-3D
   auto run = [](auto dim) {
     constexpr int D = decltype(dim)::value;
     auto sim = make_simulation<D>(scene<D>("{type: gimp, domain_update: stretch}"));
-    auto& P = sim->particles;
+    auto& P = sim->sets[0].particles;
     REQUIRE(sim->shape->nodes_per_particle() == loam::ipow(4, D));
     const int F = P.find("deformation_gradient");
     const int lp = P.find("gimp_half_width");
@@ -249,7 +249,7 @@ TEST_CASE("gimp: weights match the Bardenhagen-Kober formulas, a domain straddli
 TEST_CASE("gimp stretch: lp = lp0 F_xx, above h/2 against the exact hat average, cap and failure",
           "[shape][unit]") {
   auto sim = make_simulation<1>(scene<1>("{type: gimp, domain_update: stretch}"));
-  auto& P = sim->particles;
+  auto& P = sim->sets[0].particles;
   const int F = P.find("deformation_gradient");
   const double h = 0.1;
   std::mt19937 rng(9);
@@ -298,7 +298,7 @@ TEST_CASE("gimp stretch follows F in a deforming 2D block", "[shape][unit]") {
       "    velocity: {type: sine, amplitude: [0.3, -0.2], wavenumber: [3, 2]}\ntime: {end: 1}\n");
   loam_test::advance(*sim, 50);
   sim->shape->begin_step(*sim);
-  auto& P = sim->particles;
+  auto& P = sim->sets[0].particles;
   const int F = P.find("deformation_gradient"), lp = P.find("gimp_half_width");
   double worst = 0, min_f = 1e9, max_f = 0;
   for (size_t i = 0; i < P.size(); ++i)
@@ -413,7 +413,7 @@ TEST_CASE("bspline2: weights at and near the grid boundary (1D-3D)", "[shape][un
   auto corners = [](auto dim) {
     constexpr int D = decltype(dim)::value;
     auto sim = make_simulation<D>(scene<D>("bspline2"));
-    auto& P = sim->particles;
+    auto& P = sim->sets[0].particles;
     const double offsets[] = {0.0, 1e-12, 0.003, 0.05, 0.07, 0.1, 0.14};
     size_t i = 0;
     for (double a : offsets)
@@ -538,7 +538,7 @@ TEST_CASE("gimp stretch near the grid boundary: the exact hat average with the g
   // x within lp of either end. Tolerance: round-off (1e-13 weights, 1e-12 h * gradients, as for
   // the interior comparison above).
   auto sim = make_simulation<1>(scene<1>("{type: gimp, domain_update: stretch}"));
-  auto& P = sim->particles;
+  auto& P = sim->sets[0].particles;
   const int F = P.find("deformation_gradient");
   const double h = 0.1;
   std::mt19937 rng(23);
@@ -603,7 +603,7 @@ void for_every_shape(const Run& run) {
 /// for the positions tested here; the evaluation is what is tested, so its message is cleared.
 template <int D>
 void deform_domains(loam::Simulation<D>& sim, unsigned seed) {
-  auto& P = sim.particles;
+  auto& P = sim.sets[0].particles;
   const int F = P.find("deformation_gradient");
   if (F < 0) return;
   std::mt19937 rng(seed);
@@ -621,7 +621,7 @@ void deform_domains(loam::Simulation<D>& sim, unsigned seed) {
 /// half the particle spacing (0.025 m in these scenes).
 template <int D>
 double half_size(const loam::Simulation<D>& sim, size_t i, int d) {
-  const auto& P = sim.particles;
+  const auto& P = sim.sets[0].particles;
   if (const int lp = P.find("gimp_half_width"); lp >= 0) return P.col(lp, d)[i];
   if (const int R = P.find("cpdi_domain"); R >= 0) {
     double e = 0;
@@ -649,7 +649,7 @@ TEST_CASE(
   auto run = [](auto dim, const std::string& shape, bool deformed) {
     constexpr int D = decltype(dim)::value;
     auto sim = make_simulation<D>(scene<D>(shape));
-    auto& P = sim->particles;
+    auto& P = sim->sets[0].particles;
     if (deformed) deform_domains(*sim, 31);
     std::mt19937 rng(17 + D);
     std::uniform_int_distribution<int> where(0, 2), which(0, 9);
@@ -713,7 +713,7 @@ TEST_CASE("every shape function: a particle on a grid face is carried by the fac
     std::uniform_int_distribution<int> kind(0, 2);
     double worst_abs = 0, worst_sum = 0;
     int cases = 0;
-    const size_t n = std::min<size_t>(sim->particles.size(), 12);
+    const size_t n = std::min<size_t>(sim->sets[0].particles.size(), 12);
     for (int d = 0; d < D; ++d)
       for (int high = 0; high < 2; ++high)
         for (size_t i = 0; i < n; ++i, ++cases) {

@@ -48,7 +48,7 @@ double rad(double deg) {
 /// strain-driven with L = strain increment (dt = 1).
 template <int D>
 struct Point : loam_test::MaterialPoint<D> {
-  int eq = this->sim->particles.find("plastic_strain_eq");
+  int eq = this->sim->sets[0].particles.find("plastic_strain_eq");
 
   explicit Point(const std::string& material) : loam_test::MaterialPoint<D>(material) {
     REQUIRE(eq >= 0);

@@ -285,7 +285,7 @@ std::string column_scene() {
 template <int D>
 void fill(loam::Simulation<D>& sim, int pore, const std::vector<double>& z0, double p0, double T,
           double strain) {
-  auto& P = sim.particles;
+  auto& P = sim.sets[0].particles;
   for (size_t i = 0; i < P.size(); ++i) {
     P.col(pore)[i] = p0 * terzaghi_pressure(1 - z0[P.id[i]], T);
     P.col(P.position, D - 1)[i] = (1 - strain) * z0[P.id[i]];  // volumes: uniform either way
@@ -302,7 +302,7 @@ void check_reference_sampling() {
   // column, <= 5e-4) plus the perturbation's share 0.013/20 at T = 0.1. T = 1 is never reached:
   // its metrics and the worst-case ones are NaN. c_v = 0.01 m^2/s, H = 1 m, p0 = 1e4 Pa.
   auto sim = loam_test::make_simulation<D>(column_scene<D>());
-  auto& P = sim->particles;
+  auto& P = sim->sets[0].particles;
   const int pore = P.request({"pore_pressure", 1, "Pa", "excess pore pressure", {}});
   std::vector<double> z0(P.size());
   for (size_t i = 0; i < P.size(); ++i) z0[P.id[i]] = P.col(P.position, D - 1)[i];

@@ -53,7 +53,7 @@ Resultant nodal_resultant(loam::Simulation<2>& sim) {
 }
 
 void set_F(loam::Simulation<2>& sim, double f00, double f01, double f10, double f11) {
-  auto& P = sim.particles;
+  auto& P = sim.sets[0].particles;
   const int F = P.find("deformation_gradient");
   REQUIRE(F >= 0);
   REQUIRE(P.size() == 1);

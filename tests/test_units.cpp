@@ -24,7 +24,7 @@ std::string block_2d(const std::string& shape, const std::string& extra = "") {
 TEST_CASE("linear shape function: partition of unity, zero gradient sum, linear reproduction",
           "[shape][unit]") {
   auto sim = make_simulation<2>(block_2d("linear"));
-  auto& P = sim->particles;
+  auto& P = sim->sets[0].particles;
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (size_t i = 0; i < P.size(); ++i)
@@ -47,8 +47,8 @@ TEST_CASE("deformation gradient, when requested, stays consistent with the volum
   auto sim = make_simulation<2>(block_2d("linear",
                                          "    velocity: {type: sine, amplitude: [0.3, -0.2], "
                                          "wavenumber: [3, 2]}\n"));
-  auto& P = sim->particles;
-  const int F = P.request_deformation_gradient();
+  auto& P = sim->sets[0].particles;
+  const int F = sim->request_deformation_gradient();
   std::vector<double> v0(P.col(P.volume), P.col(P.volume) + P.size());
   std::vector<uint32_t> id0(P.id.begin(), P.id.end());
   advance(*sim, 50);
@@ -67,7 +67,7 @@ TEST_CASE("deformation gradient, when requested, stays consistent with the volum
 TEST_CASE("linear_elastic: uniaxial strain gives M eps, a rigid rotation keeps the invariants",
           "[material][unit]") {
   auto sim = make_simulation<2>(block_2d("linear"));
-  auto& P = sim->particles;
+  auto& P = sim->sets[0].particles;
   auto& mat = *sim->materials[0];
   const double E = 1e6, nu = 0.3, M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
   const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu));

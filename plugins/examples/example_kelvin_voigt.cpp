@@ -53,11 +53,12 @@ class KelvinVoigt : public loam::Material<D> {
 
   double density() const override { return rho_; }
 
-  void setup(loam::Simulation<D>& sim, int /*index*/, loam::Diagnostics&) override {
-    Particles<D>& P = sim.particles;
-    viscous_ = P.request({"viscous_stress", Particles<D>::NS, "Pa",
-                          "viscous part of the stress (Kelvin-Voigt dashpot)",
-                          Particles<D>::stress_names()});
+  void setup(loam::Simulation<D>& sim, int index, loam::Diagnostics&) override {
+    // State fields are requested through the Simulation, in the set of the body.
+    viscous_ = sim.request_field(
+        {"viscous_stress", Particles<D>::NS, "Pa",
+         "viscous part of the stress (Kelvin-Voigt dashpot)", Particles<D>::stress_names()},
+        sim.body_set(index));
     h_ = sim.grid.min_cell();
     threads_ = sim.threads;  // the run's --threads: OpenMP's default would ignore it
   }

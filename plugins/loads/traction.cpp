@@ -29,11 +29,12 @@ class Traction : public Load<D> {
  public:
   static constexpr const char* name = "traction";
   static constexpr const char* summary =
-      "traction on a body face or particle set, with a time ramp";
+      "traction on a body face or a selection of particles, with a time ramp";
   static Schema schema() {
     Schema s;
     s.text("body", "body whose face is loaded");
-    s.text("set", "particle set to load instead of a body face");
+    s.text("selection", "a named selection (`selections:`) to load instead of a body face");
+    s.text("set", "with `selection`: the particle set it selects from (default: the first)");
     s.choice("face", face_names(), "face (of the body) the traction acts on; sets the loaded area")
         .required();
     s.vector("traction", "Pa", "traction vector (force per unit area)").required();
@@ -46,8 +47,10 @@ class Traction : public Load<D> {
              "bspline2)")
         .def("particle");
     s.check([](const Params& p, Diagnostics& d) {
-      if (p.has("body") == p.has("set"))
-        d.error(p.where(), p.path(), "give exactly one of 'body' or 'set'");
+      if (p.has("body") == p.has("selection"))
+        d.error(p.where(), p.path(), "give exactly one of 'body' or 'selection'");
+      if (p.has("body") && p.has("set"))
+        d.error(p.where("set"), p.path("set"), "a body's particles are in the body's set");
     });
     return s;
   }
@@ -62,17 +65,20 @@ class Traction : public Load<D> {
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     if (!check_face(face_, D, params_, "face", diag)) return;
-    const auto& P = sim.particles;
-    if (params_.has("set")) {
-      if (!sim.particle_set(params_.text("set"), ids_)) {
-        diag.error(params_.where("set"), params_.path("set"),
-                   "unknown particle set '" + params_.text("set") + "'");
+    if (params_.has("selection")) {
+      set_ = sim.set_param(params_, "set", diag);
+      if (set_ < 0) return;
+      if (!sim.selection(params_.text("selection"), sim.sets[size_t(set_)], ids_)) {
+        diag.error(params_.where("selection"), params_.path("selection"),
+                   "unknown selection '" + params_.text("selection") + "'");
         return;
       }
     } else {
       const int b = sim.body_param(params_, "body", diag);
       if (b < 0) return;
+      set_ = sim.body_set(b);
       const Body& body = sim.bodies[size_t(b)];
+      const auto& P = sim.sets[size_t(set_)].particles;
       const double plane =
           face_.upper ? body.upper[size_t(face_.axis)] : body.lower[size_t(face_.axis)];
       const double half = 0.5 * body.spacing[size_t(face_.axis)];
@@ -84,8 +90,10 @@ class Traction : public Load<D> {
       diag.error(params_.where(), params_.path(), "the traction selects no particles");
     area_.resize(ids_.size());
     length_.resize(ids_.size());
+    const auto& set = sim.sets[size_t(set_)];
+    const auto& P = set.particles;
     for (size_t k = 0; k < ids_.size(); ++k) {
-      size_t i = sim.index_of(ids_[k]);
+      size_t i = set.index_of(ids_[k]);
       length_[k] = sim.bodies[P.body[i]].spacing[size_t(face_.axis)];
       area_[k] = P.col(P.volume)[i] / length_[k];
     }
@@ -95,18 +103,19 @@ class Traction : public Load<D> {
                    "apply_at: surface needs a shape function whose stencil covers the particle "
                    "domain (gimp, cpdi, bspline2); with this one the surface node may have no "
                    "mass and the load would be lost");
-      F_ = sim.particles.request_deformation_gradient();
+      F_ = sim.request_deformation_gradient();
     }
   }
 
   void apply_to_grid(Simulation<D>& sim, const NodalVector& force, double t) override {
     if (!surface_) return;
     const double s = ramp_factor(t, ramp_);
-    const auto& P = sim.particles;
+    const auto& set = sim.sets[size_t(set_)];
+    const auto& P = set.particles;
     const Grid<D>& g = sim.grid;
     const int a = face_.axis;
     for (size_t k = 0; k < ids_.size(); ++k) {
-      const size_t i = sim.index_of(ids_[k]);
+      const size_t i = set.index_of(ids_[k]);
       // Surface point x_p + F (s/2) N (N = +-e_a, so F N is column a of F) and its cell: per
       // axis the lower node and the tent weight of the upper.
       const double half = (face_.upper ? 0.5 : -0.5) * length_[k];
@@ -135,9 +144,10 @@ class Traction : public Load<D> {
   void apply_to_particles(Simulation<D>& sim, double t) override {
     if (surface_) return;
     const double s = ramp_factor(t, ramp_);
-    auto& P = sim.particles;
+    auto& set = sim.sets[size_t(set_)];
+    auto& P = set.particles;
     for (size_t k = 0; k < ids_.size(); ++k) {
-      size_t i = sim.index_of(ids_[k]);
+      size_t i = set.index_of(ids_[k]);
       for (int d = 0; d < D; ++d) P.col(sim.external_force, d)[i] += s * t_[size_t(d)] * area_[k];
     }
   }
@@ -148,6 +158,7 @@ class Traction : public Load<D> {
   double ramp_;
   bool surface_;
   int F_ = -1;
+  int set_ = 0;                 // the set of the loaded particles
   std::vector<double> length_;  // particle spacing normal to the face (reference length)
   std::array<double, D> t_{};
   std::vector<uint32_t> ids_;

@@ -21,26 +21,28 @@ struct Column {
     if (body < 0) return false;
     const Body& b = sim.bodies[size_t(body)];
     H0 = b.upper[D - 1] - b.lower[D - 1];
-    V0 = sum(sim, [&](size_t i) { return sim.particles.col(sim.particles.volume)[i]; });
-    pore = sim.particles.find("pore_pressure");
+    V0 = sum(sim, [&](size_t i) {
+      return sim.particles_of_body(body).col(sim.particles_of_body(body).volume)[i];
+    });
+    pore = sim.particles_of_body(body).find("pore_pressure");
     return true;
   }
   /// Sum of value(i) over the column's particles.
   template <class F>
   double sum(const Simulation<D>& sim, F&& value) const {
-    const auto& P = sim.particles;
+    const auto& P = sim.particles_of_body(body);
     double total = 0;
     for (size_t i = 0; i < P.size(); ++i)
       if (P.body[i] == body) total += value(i);
     return total;
   }
   double height(const Simulation<D>& sim) const {
-    const double* V = sim.particles.col(sim.particles.volume);
+    const double* V = sim.particles_of_body(body).col(sim.particles_of_body(body).volume);
     return sum(sim, [&](size_t i) { return V[i]; }) / (V0 / H0);
   }
   /// max |p| over the column (Pa); only meaningful when pore >= 0.
   double max_pore_pressure(const Simulation<D>& sim) const {
-    const auto& P = sim.particles;
+    const auto& P = sim.particles_of_body(body);
     double worst = 0;
     for (size_t i = 0; i < P.size(); ++i)
       if (P.body[i] == body) worst = std::max(worst, std::fabs(P.col(pore)[i]));

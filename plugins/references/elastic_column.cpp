@@ -40,14 +40,15 @@ class ElasticColumn : public Reference<D> {
     base_ = b.lower[D - 1];
     H_ = b.upper[D - 1] - base_;
     M_ = E_ * (1 - nu_) / ((1 + nu_) * (1 - 2 * nu_));
-    auto& P = sim.particles;
-    z0_ = P.request({"initial_position", D, "m", "position at t = 0", Particles<D>::axis_names()});
+    auto& P = sim.particles_of_body(body_);
+    z0_ = sim.request_field(
+        {"initial_position", D, "m", "position at t = 0", Particles<D>::axis_names()});
     for (int d = 0; d < D; ++d)
       std::copy(P.col(P.position, d), P.col(P.position, d) + P.size(), P.col(z0_, d));
   }
 
   std::map<std::string, double> metrics(Simulation<D>& sim) override {
-    const auto& P = sim.particles;
+    const auto& P = sim.particles_of_body(body_);
     const int v_comp = D - 1;           // Voigt index of sigma along the last axis
     const int h_comp = D == 1 ? 1 : 0;  // a lateral normal stress
     double mean_sv = 0, vol = 0, e2 = 0, r2 = 0, h2 = 0, hr2 = 0, u2 = 0, ur2 = 0, top_u = 0,

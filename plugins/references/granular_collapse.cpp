@@ -46,7 +46,7 @@ class GranularCollapse : public Reference<D> {
   }
 
   std::map<std::string, double> metrics(Simulation<D>& sim) override {
-    const auto& P = sim.particles;
+    const auto& P = sim.particles_of_body(body_);
     double front = -1e300, top = -1e300, v2 = 0;
     for (size_t i = 0; i < P.size(); ++i) {
       if (P.body[i] != body_) continue;

@@ -50,7 +50,7 @@ class Settlement : public Reference<D> {
   void setup(Simulation<D>& sim, Diagnostics& diag) override { col_.setup(sim, params_, diag); }
 
   std::map<std::string, double> metrics(Simulation<D>& sim) override {
-    const auto& P = sim.particles;
+    const auto& P = sim.particles_of_body(col_.body);
     const double* V = P.col(P.volume);
     const double* sv = P.col(P.stress, D - 1);  // normal stress along the last axis
     std::map<std::string, double> m;

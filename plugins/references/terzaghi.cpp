@@ -1,6 +1,6 @@
 // Reference: Terzaghi one-dimensional consolidation with one-way drainage (docs/verification.md C;
-// series in plugins/references/terzaghi.hpp). The column is a body whose top face (the last axis, upward)
-// is drained and whose base is impermeable; its excess pore pressure starts at p0 = `load`.
+// series in plugins/references/terzaghi.hpp). The column is a body whose top face (the last axis,
+// upward) is drained and whose base is impermeable; its excess pore pressure starts at p0 = `load`.
 //
 // It reads the particle field `pore_pressure` (compression positive, Pa), which a two-phase
 // scheme requests. When the run time first reaches t_k = T_k H0^2 / c_v for each requested time
@@ -63,8 +63,7 @@ class Terzaghi : public Reference<D> {
         factors_(p.vec("time_factors")) {}
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    auto& P = sim.particles;
-    pore_ = P.find("pore_pressure");
+    pore_ = sim.sets[0].particles.find("pore_pressure");  // one layout in every set
     if (pore_ < 0)
       diag.error(params_.where(), params_.path(),
                  "terzaghi needs a two-phase scheme (no pore_pressure field)");
@@ -91,7 +90,7 @@ class Terzaghi : public Reference<D> {
     const double stretch = span0_ > 0 ? (zmax - zmin) / span0_ : 1.0;
     const double top = zmax + off_top_ * stretch, base = zmin - off_base_ * stretch;
     const double H = top - base;
-    const auto& P = sim.particles;
+    const auto& P = sim.particles_of_body(body_);
     const double* z = P.col(P.position, D - 1);
     const double* p = P.col(pore_);
     const double* V = P.col(P.volume);
@@ -129,7 +128,7 @@ class Terzaghi : public Reference<D> {
 
  private:
   std::pair<double, double> span(const Simulation<D>& sim) const {
-    const auto& P = sim.particles;
+    const auto& P = sim.particles_of_body(body_);
     const double* z = P.col(P.position, D - 1);
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (size_t i = 0; i < P.size(); ++i)

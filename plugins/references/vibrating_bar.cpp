@@ -37,15 +37,15 @@ class VibratingBar : public Reference<D> {
     length_ = b.upper[0] - b.lower[0];
     x0_ = b.lower[0];
     omega_ = M_PI / (2 * length_) * std::sqrt(mat.real("E") / mat.real("density"));
-    auto& P = sim.particles;
+    auto& P = sim.particles_of_body(body_);
     // Mode shape at the initial positions, kept by particle id.
-    phi_.assign(P.size(), 0.0);
+    phi_.assign(sim.num_particles(), 0.0);  // by id: ids count over all sets
     norm_ = 0;
     for (size_t i = 0; i < P.size(); ++i) {
       if (P.body[i] != body_) continue;
       const double x = P.col(P.position, 0)[i];
       phi_[P.id[i]] = std::sin(M_PI * (x - x0_) / (2 * length_));
-      x_init_.resize(P.size());
+      x_init_.resize(sim.num_particles());
       x_init_[P.id[i]] = x;
       norm_ += P.col(P.mass)[i] * phi_[P.id[i]] * phi_[P.id[i]];
     }
@@ -53,7 +53,7 @@ class VibratingBar : public Reference<D> {
   }
 
   void sample(Simulation<D>& sim) override {
-    const auto& P = sim.particles;
+    const auto& P = sim.particles_of_body(body_);
     const double* m = P.col(P.mass);
     const double* x = P.col(P.position, 0);
     const double* vel = P.col(P.velocity, 0);

@@ -1,5 +1,6 @@
-// ParaView output: one HDF5 file per frame (particles_NNNNNN.h5) and one XDMF index
-// (particles.xdmf, a temporal collection of Polyvertex grids). 2D/1D coordinates are padded to
+// ParaView output: per particle set, one HDF5 file per frame (<set>_NNNNNN.h5, e.g.
+// particles_000003.h5) and one XDMF index (<set>.xdmf, a temporal collection of Polyvertex
+// grids; the particle count may change from frame to frame). 2D/1D coordinates are padded to
 // XYZ so that ParaView glyph filters work; D-component fields are written as 3-vectors.
 // Every file is written under a temporary name and renamed when complete.
 #include <hdf5.h>
@@ -31,36 +32,8 @@ class Xdmf : public Writer<D> {
   }
 
   void write(Simulation<D>& sim, const std::string& label) override {
-    const Particles<D>& P = sim.particles;
-    const size_t n = P.size();
-    char name[64];
-    std::snprintf(name, sizeof name, "particles_%06ld%s.h5", long(frames_.size()),
-                  label.empty() ? "" : ("_" + label).c_str());
-    std::filesystem::path file = std::filesystem::path(dir_) / name;
-    std::filesystem::path tmp = file;
-    tmp += ".tmp";
-    hid_t f = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-    Frame fr{name, sim.time, sim.step, n, {}, 0, {}};
-    write_columns(f, "position", P, P.position, 3);
-    std::vector<int> ids(n);
-    for (size_t i = 0; i < n; ++i) ids[i] = int(P.id[i]);
-    write_dataset(f, "id", ids.data(), n, 1, H5T_NATIVE_INT);
-    fr.attributes.push_back({"id", 1, "Int"});
-    for (int h : fields_) {
-      const FieldInfo& info = P.info(h);
-      // Spatial vectors (components x, y, z) are padded to 3 for ParaView; in 1D a scalar field
-      // also has D components, so the component names decide.
-      const bool spatial =
-          !info.component_names.empty() && info.component_names[0] == "x" && info.components == D;
-      const int width = spatial ? 3 : info.components;
-      write_columns(f, info.name, P, h, width);
-      fr.attributes.push_back({info.name, width, "Float"});
-    }
-    if (with_grid_) write_grid(f, sim, fr);
-    H5Fclose(f);
-    std::filesystem::rename(tmp, file);
-    frames_.push_back(fr);
-    write_index();
+    frames_.resize(sim.sets.size());
+    for (size_t s = 0; s < sim.sets.size(); ++s) write_set(sim, s, label);
   }
 
  private:
@@ -80,8 +53,46 @@ class Xdmf : public Writer<D> {
   };
   std::string dir_;
   std::vector<int> fields_;
-  std::vector<Frame> frames_;
+  std::vector<std::vector<Frame>> frames_;  // per set
   bool with_grid_;
+
+  /// One frame of set s: <set>_NNNNNN[_label].h5 with the particles (and, in the first set's
+  /// file, the grid), then the set's index <set>.xdmf.
+  void write_set(Simulation<D>& sim, size_t s, const std::string& label) {
+    const ParticleSet<D>& set = sim.sets[s];
+    const Particles<D>& P = set.particles;
+    const size_t n = P.size();
+    char name[128];
+    std::snprintf(name, sizeof name, "%s_%06ld%s.h5", set.name.c_str(), long(frames_[s].size()),
+                  label.empty() ? "" : ("_" + label).c_str());
+    std::filesystem::path file = std::filesystem::path(dir_) / name;
+    std::filesystem::path tmp = file;
+    tmp += ".tmp";
+    hid_t f = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    Frame fr{name, sim.time, sim.step, n, {}, 0, {}};
+    write_columns(f, "position", P, P.position, 3);
+    std::vector<int> ids(n);
+    for (size_t i = 0; i < n; ++i) ids[i] = int(P.id[i]);
+    write_dataset(f, "id", ids.data(), n, 1, H5T_NATIVE_INT);
+    fr.attributes.push_back({"id", 1, "Int"});
+    for (int h : fields_) {
+      if (!P.has(h)) continue;  // e.g. a material's state in a set without that material
+      const FieldInfo& info = P.info(h);
+      // Spatial vectors (components x, y, z) are padded to 3 for ParaView; in 1D a scalar field
+      // also has D components, so the component names decide.
+      const bool spatial =
+          !info.component_names.empty() && info.component_names[0] == "x" && info.components == D;
+      const int width = spatial ? 3 : info.components;
+      write_columns(f, info.name, P, h, width);
+      fr.attributes.push_back({info.name, width, "Float"});
+    }
+    const bool grid = with_grid_ && s == 0;
+    if (grid) write_grid(f, sim, fr);
+    H5Fclose(f);
+    std::filesystem::rename(tmp, file);
+    frames_[s].push_back(fr);
+    write_index(set.name, frames_[s], grid);
+  }
 
   static void write_dataset(hid_t f, const std::string& name, const void* data, size_t n, int width,
                             hid_t type) {
@@ -147,22 +158,21 @@ class Xdmf : public Writer<D> {
     x << "      </Grid>\n";
   }
 
-  void write_index() {
+  void write_index(const std::string& set, const std::vector<Frame>& frames, bool grid) {
     std::ostringstream x;
     x.precision(12);
     x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n"
-      << "    <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-    for (const auto& fr : frames_)
-      polyvertex(x, "particles", fr.file, "", fr.n, fr.attributes, fr.time);
+      << "    <Grid Name=\"" << set << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+    for (const auto& fr : frames) polyvertex(x, set, fr.file, "", fr.n, fr.attributes, fr.time);
     x << "    </Grid>\n";
-    if (with_grid_) {
+    if (grid) {
       x << "    <Grid Name=\"grid\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-      for (const auto& fr : frames_)
+      for (const auto& fr : frames)
         polyvertex(x, "grid", fr.file, "grid_", fr.grid_nodes, fr.grid_attributes, fr.time);
       x << "    </Grid>\n";
     }
     x << "  </Domain>\n</Xdmf>\n";
-    std::filesystem::path file = std::filesystem::path(dir_) / "particles.xdmf";
+    std::filesystem::path file = std::filesystem::path(dir_) / (set + ".xdmf");
     std::filesystem::path tmp = file;
     tmp += ".tmp";
     {

@@ -1,0 +1,36 @@
+#pragma once
+// Sink plugin interface: removes particles while the run goes (an outlet, a constant water
+// level). After the scheme's step a sink marks the particles of a set to remove; the Simulation
+// removes them (every field of every plugin with them, through the one field layout) and counts
+// their mass in the run's mass balance.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace loam {
+
+template <int D>
+class Simulation;
+template <int D>
+class ParticleSet;
+class Diagnostics;
+
+template <int D>
+class Sink {
+ public:
+  static constexpr const char* kind = "sink";
+  virtual ~Sink() = default;
+  virtual void setup(Simulation<D>&, Diagnostics&) {}
+  /// Set remove[i] = 1 for each particle i of `set` to remove after this step (remove has the
+  /// set's size and arrives zeroed or marked by other sinks).
+  virtual void mark(const Simulation<D>&, const ParticleSet<D>& set,
+                    std::vector<uint8_t>& remove) const = 0;
+  /// Whether it removes particles that leave the grid through a face no mechanical condition
+  /// holds (so that they are not an unstable run).
+  virtual bool removes_leaving_particles() const { return false; }
+  /// Whether it would remove particles somewhere in the box [lower, upper] (a source's region).
+  virtual bool overlaps(const std::array<double, D>& lower,
+                        const std::array<double, D>& upper) const = 0;
+};
+
+}  // namespace loam
