@@ -11,6 +11,16 @@
 
 namespace loam {
 
+/// The accumulated equivalent plastic deviatoric strain, the state field the elastoplastic
+/// materials share (and output under one name).
+inline FieldInfo plastic_strain_eq_field() {
+  return {"plastic_strain_eq",
+          1,
+          "-",
+          "equivalent plastic deviatoric strain sqrt(2/3 e:e), accumulated",
+          {}};
+}
+
 class Diagnostics;
 class Params;
 

@@ -22,6 +22,7 @@ constexpr int kBlock = 64;
 
 template <int D>
 struct StencilBlock {
+  static constexpr int dimension = D;
   int count = 0;              // particles in this block
   int npp = 0;                // stencil entries per particle
   std::vector<int32_t> node;  // [k*kBlock + p]

@@ -7,13 +7,14 @@
 #include <cstdint>
 #include <vector>
 
+#include "params.hpp"
+
 namespace loam {
 
 template <int D>
 class Simulation;
 template <int D>
 class ParticleSet;
-class Diagnostics;
 
 template <int D>
 class Sink {
@@ -31,6 +32,27 @@ class Sink {
   /// Whether it would remove particles somewhere in the box [lower, upper] (a source's region).
   virtual bool overlaps(const std::array<double, D>& lower,
                         const std::array<double, D>& upper) const = 0;
+};
+
+/// A sink that acts on every set or on the one its `set` key names.
+template <int D>
+class SinkOnSets : public Sink<D> {
+ public:
+  explicit SinkOnSets(const Params& p) : params_(p) {}
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    if (params_.has("set")) set_ = sim.set_param(params_, "set", diag);
+  }
+  /// Whether particles of `set` are removed by this sink.
+  bool acts_on(const Simulation<D>& sim, const ParticleSet<D>& set) const {
+    return set_ < 0 || &set == &sim.sets[size_t(set_)];
+  }
+  static void add_set_param(Schema& s) {
+    s.text("set", "remove only particles of this set (default: every set)");
+  }
+
+ protected:
+  Params params_;
+  int set_ = -1;  // -1: every set
 };
 
 }  // namespace loam

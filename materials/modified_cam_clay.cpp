@@ -212,12 +212,7 @@ class ModifiedCamClay : public Material<D> {
                              "preconsolidation pressure p'_c (size of the Cam Clay yield ellipse)",
                              {}},
                             set);
-    eq_ = sim.request_field({"plastic_strain_eq",
-                             1,
-                             "-",
-                             "equivalent plastic deviatoric strain sqrt(2/3 e:e), accumulated",
-                             {}},
-                            set);
+    eq_ = sim.request_field(plastic_strain_eq_field(), set);
   }
 
   void initialize(Particles<D>& P, size_t b, size_t e) override {

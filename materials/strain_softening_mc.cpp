@@ -131,12 +131,7 @@ class StrainSofteningMC : public Material<D> {
 
   void setup(Simulation<D>& sim, int m, Diagnostics&) override {
     const int set = sim.body_set(m);  // state fields live in the set of the body
-    eq_ = sim.request_field({"plastic_strain_eq",
-                             1,
-                             "-",
-                             "equivalent plastic deviatoric strain sqrt(2/3 e:e), accumulated",
-                             {}},
-                            set);
+    eq_ = sim.request_field(plastic_strain_eq_field(), set);
   }
 
   double wave_speed(const Particles<D>& P, size_t b, size_t e) const override {

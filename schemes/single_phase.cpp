@@ -10,8 +10,7 @@
 
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
-#include "framework/tensor.hpp"
-#include "framework/thread_scratch.hpp"
+#include "framework/step_blocks.hpp"
 
 namespace loam {
 
@@ -63,22 +62,19 @@ class SinglePhase : public Scheme<D> {
   void setup(Simulation<D>& sim, Diagnostics&) override {
     node_.assign(sim.grid.num_nodes * S, 0.0);
     vel_.assign(sim.grid.num_nodes * D, 0.0);
-    const int npp = sim.shape->nodes_per_particle();
-    scratch_ = per_thread_scratch<Scratch>(sim.threads, [&](Scratch& s) {
-      s.stencil.allocate(npp);
-      s.L.assign(size_t(D * D * kBlock), 0.0);
-    });
+    scratch_ =
+        make_block_scratch<Scratch>(sim.threads, sim.shape->nodes_per_particle(), [](Scratch&) {});
   }
 
   std::vector<GridFieldView> grid_fields() const override {
-    return {{"mass", 1, node_.data(), S, 0},
+    return {{"mass", 1, node_.data(), S, kMass},
             {"velocity", D, vel_.data(), D, 0},
-            {"acceleration", D, node_.data(), S, 1 + D}};
+            {"acceleration", D, node_.data(), S, kForce}};
   }
 
   void step(Simulation<D>& sim, double dt) override {
     // Plugins may request F after this scheme's set-up; look it up once per step.
-    deformation_gradient_ = sim.deformation_gradient;
+    F_ = sim.deformation_gradient;
     with_stencil_size<D>(sim.shape->nodes_per_particle(), [&](auto npp) {
       constexpr int NPP = decltype(npp)::value;
       if (update_ == "usf")
@@ -89,33 +85,93 @@ class SinglePhase : public Scheme<D> {
   }
 
  private:
-  // Node record for the scatter: mass, momentum (D), force (D). After integration the momentum
-  // slot holds the updated velocity and the force slot the acceleration.
-  static constexpr int S = 1 + 2 * D;
+  // Node record for the scatter: mass, momentum (D), force (D). After the nodal update the
+  // momentum slot holds the updated velocity and the force slot the acceleration.
+  static constexpr int kMass = 0, kMomentum = 1, kForce = 1 + D, S = 1 + 2 * D;
   static constexpr int NS = Particles<D>::NS;
   std::string update_;
   double flip_;
   std::vector<std::string> sets_;
-  int deformation_gradient_ = -1;
+  int F_ = -1;                // deformation gradient handle, or -1
   std::vector<double> node_;  // num_nodes * S
   std::vector<double> vel_;   // num_nodes * D: velocity used for the velocity gradient
-  struct alignas(64) Scratch {
-    StencilBlock<D> stencil;
-    std::vector<double> L;
-    double max_v2 = 0;
-  };
+  using Scratch = BlockScratch<D>;
   std::vector<std::unique_ptr<Scratch>> scratch_;
 
   NodalVector node_vector(int offset) { return NodalVector{node_.data(), S, offset}; }
   NodalVector vel_vector() { return NodalVector{vel_.data(), D, 0}; }
 
-  void zero(std::vector<double>& v, int threads) {
-    const long n = long(v.size());
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (long i = 0; i < n; ++i) v[size_t(i)] = 0.0;
+  // ------------------------------------------------------------------ the steps
+  template <int NPP>
+  void step_usl_musl(Simulation<D>& sim, double dt, bool musl) {
+    sim.timed("grid", [&] { zero_nodes(node_, sim.threads); });
+    sim.timed("p2g", [&] { scatter_all<NPP, true, true>(sim); });
+    sim.timed("grid", [&] { update_nodes(sim, dt); });
+    reset_max_speed(scratch_);
+    if (musl) {
+      // MUSL: re-map the updated particle momentum; the velocity gradient uses that field, and
+      // particles move with the grid velocity of the update (Sulsky 1995).
+      sim.timed("grid", [&] { zero_nodes(vel_, sim.threads); });
+      sim.timed("g2p_velocity_remap", [&] { update_velocities<NPP, true, false>(sim, dt); });
+      sim.timed("grid", [&] { momentum_to_velocity(sim, vel_.data(), D, 0); });
+      sim.timed("g2p_gradient_stress", [&] { update_stresses<NPP, Gradient::kRemapped>(sim, dt); });
+    } else {
+      // USL: gradient, move and velocity update from the updated grid record in one pass.
+      sim.timed("g2p_gradient_stress", [&] { update_stresses<NPP, Gradient::kUpdated>(sim, dt); });
+    }
+    sim.max_speed = max_speed(scratch_);
   }
 
-  /// Particle-to-grid: mass and momentum (MOMENTUM), internal, gravity and external forces (FORCE).
+  template <int NPP>
+  void step_usf(Simulation<D>& sim, double dt) {
+    // USF: stress from the velocity field at t^n, then forces, then the grid update.
+    zero_nodes(node_, sim.threads);
+    scatter_all<NPP, true, false>(sim);
+    momentum_to_velocity(sim, node_.data(), S, kMomentum);
+    update_stresses<NPP, Gradient::kCurrent>(sim, dt);
+    scatter_all<NPP, false, true>(sim);
+    update_nodes(sim, dt);
+    reset_max_speed(scratch_);
+    update_velocities<NPP, false, true>(sim, dt);
+    sim.max_speed = max_speed(scratch_);
+  }
+
+  // ------------------------------------------------------------------ the phases
+  /// P2G over every set: mass and momentum (MOMENTUM), internal, gravity and external forces
+  /// (FORCE), all sets summed onto the one node record.
+  template <int NPP, bool MOMENTUM, bool FORCE>
+  void scatter_all(Simulation<D>& sim) {
+    sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+      scatter<NPP, MOMENTUM, FORCE>(sim, s, b, c, t);
+    });
+  }
+  /// G2P velocity update (FLIP/PIC); with REMAP the new momentum is scattered into vel_ (MUSL),
+  /// with MOVE the particles move with the updated grid velocity.
+  template <int NPP, bool REMAP, bool MOVE>
+  void update_velocities(Simulation<D>& sim, double dt) {
+    auto f = [&](ParticleSet<D>& s, size_t b, int c, int t) {
+      update_velocity<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
+    };
+    if constexpr (REMAP)
+      sim.scatter_blocks(f);
+    else
+      sim.gather_blocks(f);
+  }
+  /// What the gradient pass does besides the velocity gradient, volume and stress update.
+  enum class Gradient {
+    kRemapped,  // MUSL: L from the re-mapped velocity vel_; move with the updated grid velocity
+    kCurrent,   // USF: L from vel_ (velocity at t^n); particles do not move here
+    kUpdated,   // USL: L, move and FLIP update all from the updated grid record, in one pass
+  };
+  template <int NPP, Gradient MODE>
+  void update_stresses(Simulation<D>& sim, double dt) {
+    sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+      update_stress<NPP, MODE>(sim, s, dt, b, c, t);
+    });
+  }
+
+  // ------------------------------------------------------------------ kernels
+  /// Particle-to-grid for one block: mass and momentum (MOMENTUM), forces (FORCE).
   template <int NPP, bool MOMENTUM, bool FORCE>
   void scatter(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
     Particles<D>& P = set.particles;
@@ -144,8 +200,8 @@ class SinglePhase : public Scheme<D> {
         const double w = st.w[kp];
         double* r = g + size_t(st.node[kp]) * S;
         if constexpr (MOMENTUM) {
-          r[0] += w * m[p];
-          for (int d = 0; d < D; ++d) r[1 + d] += w * mv[d];
+          r[kMass] += w * m[p];
+          for (int d = 0; d < D; ++d) r[kMomentum + d] += w * mv[d];
         }
         if constexpr (FORCE) {
           double gr[D];
@@ -154,60 +210,57 @@ class SinglePhase : public Scheme<D> {
           for (int d = 0; d < D; ++d) {
             double f = w * body[d];
             for (int j = 0; j < D; ++j) f -= sv[d][j] * gr[j];  // f_int = -V sigma . grad N
-            r[1 + D + d] += f;
+            r[kForce + d] += f;
           }
         }
       }
     }
   }
 
-  /// Nodal forces to updated velocity and acceleration, with loads, damping and constraints.
-  void integrate(Simulation<D>& sim, double dt) {
-    sim.apply_grid_loads(node_vector(1 + D));
+  /// Nodal forces to updated velocity and acceleration, with loads, face forces, damping and
+  /// the boundary conditions: v^{n+1} = (p + dt f) / m, a = f / m.
+  void update_nodes(Simulation<D>& sim, double dt) {
+    sim.apply_grid_loads(node_vector(kForce));
     GridForces forces;
-    forces.mixture = node_vector(1 + D);
+    forces.mixture = node_vector(kForce);
     sim.apply_boundary_forces(forces);
-    sim.apply_damping(
-        NodeForces{node_.data(), node_vector(1), node_vector(1 + D), sim.grid.num_nodes, S});
-    const long n = long(sim.grid.num_nodes);
+    sim.apply_damping(NodeForces{node_.data(), node_vector(kMomentum), node_vector(kForce),
+                                 sim.grid.num_nodes, S});
     const double tol = sim.mass_tolerance;
     double* g = node_.data();
-#pragma omp parallel for schedule(static) num_threads(sim.threads)
-    for (long i = 0; i < n; ++i) {
-      double* r = g + size_t(i) * S;
-      if (r[0] > tol) {
-        const double inv = 1.0 / r[0];
+    for_each_node(sim.grid.num_nodes, sim.threads, [&](size_t i) {
+      double* r = g + i * S;
+      if (r[kMass] > tol) {
+        const double inv = 1.0 / r[kMass];
         for (int d = 0; d < D; ++d) {
-          const double a = r[1 + D + d] * inv;
-          r[1 + d] = r[1 + d] * inv + dt * a;  // v^{n+1} = (p + dt f) / m
-          r[1 + D + d] = a;
+          const double a = r[kForce + d] * inv;
+          r[kMomentum + d] = r[kMomentum + d] * inv + dt * a;
+          r[kForce + d] = a;
         }
       } else {
-        for (int d = 0; d < 2 * D; ++d) r[1 + d] = 0.0;
+        for (int d = 0; d < 2 * D; ++d) r[kMomentum + d] = 0.0;
       }
-    }
+    });
     GridUpdate u;
-    u.phases[0] = {node_vector(1), node_vector(1 + D), node_vector(0)};
+    u.phases[0] = {node_vector(kMomentum), node_vector(kForce), node_vector(kMass)};
     u.dt = dt;
     sim.constrain_update(u);
   }
 
   /// Velocity from momentum in vel_ (MUSL re-map, USF), constrained.
   void momentum_to_velocity(Simulation<D>& sim, const double* momentum, int stride, int offset) {
-    const long n = long(sim.grid.num_nodes);
     const double tol = sim.mass_tolerance;
-#pragma omp parallel for schedule(static) num_threads(sim.threads)
-    for (long i = 0; i < n; ++i) {
-      const double m = node_[size_t(i) * S];
+    for_each_node(sim.grid.num_nodes, sim.threads, [&](size_t i) {
+      const double m = node_[i * S + kMass];
       for (int d = 0; d < D; ++d)
-        vel_[size_t(i) * D + size_t(d)] =
-            m > tol ? momentum[size_t(i) * size_t(stride) + size_t(offset + d)] / m : 0.0;
-    }
+        vel_[i * D + size_t(d)] =
+            m > tol ? momentum[i * size_t(stride) + size_t(offset + d)] / m : 0.0;
+    });
     sim.constrain(vel_vector());
   }
 
-  /// Grid-to-particle velocity update (FLIP/PIC blend). With REMAP, scatter the new particle
-  /// momentum into vel_ (MUSL). With MOVE, also move particles with the updated grid velocity.
+  /// Grid-to-particle velocity update of one block (FLIP/PIC blend); REMAP and MOVE as in
+  /// update_velocities.
   template <int NPP, bool REMAP, bool MOVE>
   void update_velocity(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
                        int thread) {
@@ -223,7 +276,6 @@ class SinglePhase : public Scheme<D> {
       x[size_t(d)] = P.col(P.position, d) + b;
     }
     const double* g = node_.data();
-    const double flip = flip_;
     double max_v2 = sc.max_v2;
     for (int p = 0; p < count; ++p) {
       double a[D] = {}, vn[D] = {};
@@ -232,14 +284,14 @@ class SinglePhase : public Scheme<D> {
         const double w = st.w[kp];
         const double* r = g + size_t(st.node[kp]) * S;
         for (int d = 0; d < D; ++d) {
-          vn[d] += w * r[1 + d];
-          a[d] += w * r[1 + D + d];
+          vn[d] += w * r[kMomentum + d];
+          a[d] += w * r[kForce + d];
         }
       }
       double v2 = 0;
       for (int d = 0; d < D; ++d) {
         double& vp = v[size_t(d)][p];
-        vp = flip * (vp + dt * a[d]) + (1.0 - flip) * vn[d];
+        vp = flip_pic(flip_, vp, dt, a[d], vn[d]);
         v2 += vp * vp;
         if constexpr (MOVE) x[size_t(d)][p] += dt * vn[d];
       }
@@ -256,15 +308,8 @@ class SinglePhase : public Scheme<D> {
     sc.max_v2 = max_v2;
   }
 
-  /// What the gradient pass does besides the velocity gradient, volume and stress update.
-  enum class Gradient {
-    kRemapped,  // MUSL: L from the re-mapped velocity vel_; move with the updated grid velocity
-    kCurrent,   // USF: L from vel_ (velocity at t^n); particles do not move here
-    kUpdated,   // USL: L, move and FLIP update all from the updated grid record, in one pass
-  };
-
-  /// Velocity gradient, volume update, optional move / velocity update, and the material's
-  /// stress update for one block.
+  /// Velocity gradient, volume and F update, optional move / velocity update, and the
+  /// material's stress update for one block.
   template <int NPP, Gradient MODE>
   void update_stress(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
                      int thread) {
@@ -283,43 +328,33 @@ class SinglePhase : public Scheme<D> {
       v[size_t(d)] = P.col(P.velocity, d) + b;
     }
     const double* g = node_.data();
-    std::array<double*, D * D> F{};  // deformation gradient, if some plugin requested it
-    if (deformation_gradient_ >= 0)
-      for (int c = 0; c < D * D; ++c) F[size_t(c)] = P.col(deformation_gradient_, c) + b;
+    const auto F = deformation_gradient_block(P, F_, b);
     // Source of the velocity field whose gradient is taken.
-    const double* vel = kFromRecord ? node_.data() + 1 : vel_.data();
+    const double* vel = kFromRecord ? node_.data() + kMomentum : vel_.data();
     const size_t vstride = kFromRecord ? S : D;
-    const double flip = flip_;
     double max_v2 = sc.max_v2;
     for (int p = 0; p < count; ++p) {
       double l[D][D] = {}, vn[D] = {}, a[D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const size_t n = size_t(st.node[kp]);
-        const double* vv = vel + n * vstride;
-        for (int j = 0; j < D; ++j) {
-          const double gj = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
-          for (int i = 0; i < D; ++i) l[i][j] += vv[i] * gj;
-        }
+        add_velocity_gradient<D>(l, vel + n * vstride, st, size_t(k), p);
         if constexpr (kMove) {
           const double w = st.w[kp];
-          for (int d = 0; d < D; ++d) vn[d] += w * g[n * S + 1 + size_t(d)];
+          for (int d = 0; d < D; ++d) vn[d] += w * g[n * S + kMomentum + size_t(d)];
           if constexpr (kFromRecord)
-            for (int d = 0; d < D; ++d) a[d] += w * g[n * S + 1 + D + size_t(d)];
+            for (int d = 0; d < D; ++d) a[d] += w * g[n * S + kForce + size_t(d)];
         }
       }
-      for (int i = 0; i < D; ++i)
-        for (int j = 0; j < D; ++j) L[size_t(i * D + j) * kBlock + size_t(p)] = l[i][j];
-      // V^{n+1} = det(I + L dt) V^n
-      V[p] *= det_increment(l, dt);
-      if (F[0]) update_deformation_gradient(F, l, dt, p);
+      store_velocity_gradient<D>(l, L, p);
+      update_volume_and_deformation<D>(l, dt, V[p], F, p);
       if constexpr (kMove)
         for (int d = 0; d < D; ++d) x[size_t(d)][p] += dt * vn[d];
       if constexpr (kFromRecord) {
         double v2 = 0;
         for (int d = 0; d < D; ++d) {
           double& vp = v[size_t(d)][p];
-          vp = flip * (vp + dt * a[d]) + (1.0 - flip) * vn[d];
+          vp = flip_pic(flip_, vp, dt, a[d], vn[d]);
           v2 += vp * vp;
         }
         max_v2 = std::max(max_v2, v2);
@@ -327,73 +362,6 @@ class SinglePhase : public Scheme<D> {
     }
     sc.max_v2 = max_v2;
     sim.update_block_stress(set, b, count, dt, L);
-  }
-
-  void reset_max_speed() {
-    for (auto& s : scratch_) s->max_v2 = 0;
-  }
-  void store_max_speed(Simulation<D>& sim) {
-    double m = 0;
-    for (auto& s : scratch_) m = std::max(m, s->max_v2);
-    sim.max_speed = std::sqrt(m);
-  }
-
-  template <int NPP>
-  void step_usl_musl(Simulation<D>& sim, double dt, bool musl) {
-    sim.timed("grid", [&] { zero(node_, sim.threads); });
-    sim.timed("p2g", [&] {
-      sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-        scatter<NPP, true, true>(sim, s, b, c, t);
-      });
-    });
-    sim.timed("grid", [&] { integrate(sim, dt); });
-    reset_max_speed();
-    if (musl) {
-      // MUSL: re-map the updated particle momentum; the velocity gradient uses that field, and
-      // particles move with the grid velocity of the update (Sulsky 1995).
-      sim.timed("grid", [&] { zero(vel_, sim.threads); });
-      sim.timed("g2p_velocity_remap", [&] {
-        sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-          update_velocity<NPP, true, false>(sim, s, dt, b, c, t);
-        });
-      });
-      sim.timed("grid", [&] { momentum_to_velocity(sim, vel_.data(), D, 0); });
-      sim.timed("g2p_gradient_stress", [&] {
-        sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-          update_stress<NPP, Gradient::kRemapped>(sim, s, dt, b, c, t);
-        });
-      });
-    } else {
-      // USL: gradient, move and velocity update from the updated grid record in one pass.
-      sim.timed("g2p_gradient_stress", [&] {
-        sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-          update_stress<NPP, Gradient::kUpdated>(sim, s, dt, b, c, t);
-        });
-      });
-    }
-    store_max_speed(sim);
-  }
-
-  template <int NPP>
-  void step_usf(Simulation<D>& sim, double dt) {
-    // USF: stress from the velocity field at t^n, then forces, then the grid update.
-    zero(node_, sim.threads);
-    sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-      scatter<NPP, true, false>(sim, s, b, c, t);
-    });
-    momentum_to_velocity(sim, node_.data(), S, 1);
-    sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-      update_stress<NPP, Gradient::kCurrent>(sim, s, dt, b, c, t);
-    });
-    sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-      scatter<NPP, false, true>(sim, s, b, c, t);
-    });
-    integrate(sim, dt);
-    reset_max_speed();
-    sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-      update_velocity<NPP, false, true>(sim, s, dt, b, c, t);
-    });
-    store_max_speed(sim);
   }
 };
 

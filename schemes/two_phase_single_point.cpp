@@ -58,8 +58,8 @@
 #include "framework/drag.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "framework/step_blocks.hpp"
 #include "framework/tensor.hpp"
-#include "framework/thread_scratch.hpp"
 
 namespace loam {
 
@@ -125,12 +125,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     dp_.assign(P.size(), 0.0);
     if (smooth_) cell_.assign(sim.grid.num_cells * 2, 0.0);
     if (musl_) remap_.assign(sim.grid.num_nodes * 2 * D, 0.0);
-    const int npp = sim.shape->nodes_per_particle();
-    scratch_ = per_thread_scratch<Scratch>(sim.threads, [&](Scratch& s) {
-      s.stencil.allocate(npp);
-      s.L.assign(size_t(D * D * kBlock), 0.0);
-      s.Q.assign(size_t(kBlock), 0.0);
-    });
+    scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->nodes_per_particle(),
+                                           [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
   }
 
   /// Porosity n0, solid mass (1 - n0) rho_s V (the material density is rho_s), water velocity
@@ -202,54 +198,58 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   }
 
   void step(Simulation<D>& sim, double dt) override {
-    F_ = sim.deformation_gradient;   // may be requested after our set-up
-    dp_.resize(sim.sets[0].size());  // the count changes with sources and sinks
-    with_stencil_size<D>(sim.shape->nodes_per_particle(), [&](auto npp) {
-      constexpr int NPP = decltype(npp)::value;
-      sim.timed("grid", [&] { std::fill(node_.begin(), node_.end(), 0.0); });
-      sim.timed("p2g", [&] {
-        sim.scatter_blocks(
-            [&](ParticleSet<D>& s, size_t b, int c, int t) { scatter<NPP>(sim, s, b, c, t); });
-      });
-      sim.timed("grid", [&] { integrate(sim, dt); });
-      for (auto& s : scratch_) s->max_v2 = 0;
-      if (musl_) {
-        move_.resize(sim.sets[0].size() * D);  // the count changes with sources and sinks
-        sim.timed("grid", [&] { std::fill(remap_.begin(), remap_.end(), 0.0); });
-        sim.timed("g2p_velocity_remap", [&] {
-          sim.scatter_blocks(
-              [&](ParticleSet<D>& s, size_t b, int c, int t) { remap<NPP>(sim, s, dt, b, c, t); });
-        });
-        sim.timed("grid", [&] { remapped_velocities(sim); });
-        sim.timed("g2p_gradient_stress", [&] {
-          sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-            update<NPP, true>(sim, s, dt, b, c, t);
-          });
-        });
-      } else {
-        sim.timed("g2p_gradient_stress", [&] {
-          sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-            update<NPP, false>(sim, s, dt, b, c, t);
-          });
-        });
-      }
-      sim.timed("pore_pressure", [&] { apply_pressure_increment(sim); });
-      double m = 0;
-      for (auto& s : scratch_) m = std::max(m, s->max_v2);
-      sim.max_speed = std::sqrt(m);
-      for (auto& s : scratch_)
-        if (s->bad_porosity >= 0) {
-          const size_t i = size_t(s->bad_porosity);
-          const auto& P = sim.sets[0].particles;
-          sim.failure = "particle " + std::to_string(P.id[i]) +
-                        ": porosity left (0, 1) (n = " + format_number(P.col(n_)[i]) +
-                        "); the skeleton was compressed to zero pore volume or torn apart";
-          s->bad_porosity = -1;
-        }
-    });
+    F_ = sim.deformation_gradient;  // may be requested after our set-up
+    // Per-particle scratch follows the particle count (sources and sinks change it).
+    dp_.resize(sim.sets[0].size());
+    if (musl_) move_.resize(sim.sets[0].size() * D);
+    with_stencil_size<D>(sim.shape->nodes_per_particle(),
+                         [&](auto npp) { step_phases<decltype(npp)::value>(sim, dt); });
   }
 
  private:
+  template <int NPP>
+  void step_phases(Simulation<D>& sim, double dt) {
+    sim.timed("grid", [&] { zero_nodes(node_, sim.threads); });
+    sim.timed("p2g", [&] {
+      sim.scatter_blocks(
+          [&](ParticleSet<D>& s, size_t b, int c, int t) { scatter<NPP>(sim, s, b, c, t); });
+    });
+    sim.timed("grid", [&] { integrate(sim, dt); });
+    reset_max_speed(scratch_);
+    if (musl_) {
+      sim.timed("grid", [&] { zero_nodes(remap_, sim.threads); });
+      sim.timed("g2p_velocity_remap", [&] {
+        sim.scatter_blocks(
+            [&](ParticleSet<D>& s, size_t b, int c, int t) { remap<NPP>(sim, s, dt, b, c, t); });
+      });
+      sim.timed("grid", [&] { remapped_velocities(sim); });
+    }
+    sim.timed("g2p_gradient_stress", [&] {
+      sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+        if (musl_)
+          update<NPP, true>(sim, s, dt, b, c, t);
+        else
+          update<NPP, false>(sim, s, dt, b, c, t);
+      });
+    });
+    sim.timed("pore_pressure", [&] { apply_pressure_increment(sim); });
+    sim.max_speed = max_speed(scratch_);
+    report_bad_porosity(sim);
+  }
+
+  /// A particle whose porosity left (0, 1) in the step ends the run (Simulation::failure).
+  void report_bad_porosity(Simulation<D>& sim) {
+    for (auto& s : scratch_)
+      if (s->bad_porosity >= 0) {
+        const size_t i = size_t(s->bad_porosity);
+        const auto& P = sim.sets[0].particles;
+        sim.failure = "particle " + std::to_string(P.id[i]) +
+                      ": porosity left (0, 1) (n = " + format_number(P.col(n_)[i]) +
+                      "); the skeleton was compressed to zero pore volume or torn apart";
+        s->bad_porosity = -1;
+      }
+  }
+
   // Node record: solid mass, water mass, solid momentum -> velocity, water momentum ->
   // velocity, mixture force -> solid acceleration, water force -> water acceleration, drag Q,
   // volume -> porosity.
@@ -270,10 +270,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   std::vector<double> dp_, cell_;
   std::vector<size_t> cell_index_;  // each particle's cell, from the first pass
   bool smooth_ = true;
-  struct alignas(64) Scratch {
-    StencilBlock<D> stencil;
-    std::vector<double> L, Q;
-    double max_v2 = 0;
+  struct Scratch : BlockScratch<D> {
+    std::vector<double> Q;   // drag coefficients of the block
     long bad_porosity = -1;  // a particle whose porosity left (0, 1) this step
   };
   std::vector<std::unique_ptr<Scratch>> scratch_;
@@ -415,7 +413,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// would add a spurious -p grad n where n varies).
   void water_force_and_porosity(Simulation<D>& sim) {
     const double tol = sim.mass_tolerance;
-    for_each_node(sim, [&](double* r, size_t) {
+    for_each_record(sim, [&](double* r, size_t) {
       if (r[kMs] <= tol) {
         r[kN] = 0.0;
         return;
@@ -427,11 +425,9 @@ class TwoPhaseSinglePoint : public Scheme<D> {
 
   /// f(record, node) for every grid node, in parallel (static schedule).
   template <class F>
-  void for_each_node(const Simulation<D>& sim, F&& f) {
-    const long nn = long(sim.grid.num_nodes);
+  void for_each_record(const Simulation<D>& sim, F&& f) {
     double* g = node_.data();
-#pragma omp parallel for schedule(static) num_threads(sim.threads)
-    for (long i = 0; i < nn; ++i) f(g + size_t(i) * S, size_t(i));
+    for_each_node(sim.grid.num_nodes, sim.threads, [&](size_t i) { f(g + i * S, i); });
   }
 
   /// Local damping (damping:) acts on the mixture's momentum balance: the net nodal force of
@@ -440,7 +436,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// would slow steady seepage (where the water force balances the drag, not zero) by (1 - alpha).
   void damp_mixture(Simulation<D>& sim) {
     if (!sim.damping) return;
-    for_each_node(sim, [&](const double* r, size_t i) {
+    for_each_record(sim, [&](const double* r, size_t i) {
       for (int d = 0; d < D; ++d) mixture_momentum_[i * D + size_t(d)] = r[kV + d] + r[kW + d];
     });
     sim.apply_damping(NodeForces{node_.data() + kMs, NodalVector{mixture_momentum_.data(), D, 0},
@@ -454,7 +450,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// solved_ keeps the velocities of the solve for follow_held_phase().
   void solve_coupled(Simulation<D>& sim, double dt) {
     const double tol = sim.mass_tolerance;
-    for_each_node(sim, [&](double* r, size_t i) {
+    for_each_record(sim, [&](double* r, size_t i) {
       double* solved = solved_.data() + i * 2 * D;
       const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
       if (ms <= tol) {
@@ -489,7 +485,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// (both held, tied by impermeable, damped by a dashpot) is left as its conditions set it.
   void follow_held_phase(Simulation<D>& sim, double dt) {
     const double tol = sim.mass_tolerance;
-    for_each_node(sim, [&](double* r, size_t i) {
+    for_each_record(sim, [&](double* r, size_t i) {
       const double* solved = solved_.data() + i * 2 * D;
       const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
       if (ms <= tol || mw <= tol || !(Q > 0)) return;
@@ -540,17 +536,15 @@ class TwoPhaseSinglePoint : public Scheme<D> {
 
   /// Remapped momenta to velocities (node masses of the step), constrained like the update.
   void remapped_velocities(Simulation<D>& sim) {
-    const long nn = long(sim.grid.num_nodes);
     const double tol = sim.mass_tolerance;
-#pragma omp parallel for schedule(static) num_threads(sim.threads)
-    for (long i = 0; i < nn; ++i) {
-      const double ms = node_[size_t(i) * S + kMs], mw = node_[size_t(i) * S + kMw];
-      double* r = remap_.data() + size_t(i) * 2 * D;
+    for_each_record(sim, [&](const double* g, size_t i) {
+      const double ms = g[kMs], mw = g[kMw];
+      double* r = remap_.data() + i * 2 * D;
       for (int d = 0; d < D; ++d) {
         r[d] = ms > tol ? r[d] / ms : 0.0;
         r[D + d] = mw > tol ? r[D + d] / mw : r[d];
       }
-    }
+    });
     sim.constrain(NodalVector{remap_.data(), 2 * D, 0});
     sim.constrain(NodalVector{remap_.data(), 2 * D, D}, 1);
   }
@@ -577,8 +571,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     for (int d = 0; d < D; ++d) {
       double& v = P.col(P.velocity, d)[i];
       double& w = P.col(w_, d)[i];
-      v = flip_ * (v + dt * as[d]) + (1 - flip_) * vn[d];
-      w = flip_ * (w + dt * aw[d]) + (1 - flip_) * wn[d];
+      v = flip_pic(flip_, v, dt, as[d], vn[d]);
+      w = flip_pic(flip_, w, dt, aw[d], wn[d]);
       if constexpr (MOVE)
         P.col(P.position, d)[i] += dt * vn[d];
       else
@@ -598,9 +592,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     const double* g = node_.data();
     double* L = sc.L.data();
     double max_v2 = sc.max_v2;
-    std::array<double*, D * D> F{};  // deformation gradient, if a material requested it
-    if (F_ >= 0)
-      for (int c = 0; c < D * D; ++c) F[size_t(c)] = P.col(F_, c) + b;
+    const auto F = deformation_gradient_block(P, F_, b);
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       // USL: the velocity update happens here; MUSL did it in the re-map pass.
@@ -614,13 +606,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         // Velocities whose gradients are taken: re-mapped (MUSL) or updated grid ones (USL).
         const double* vs = REMAPPED ? remap_.data() + size_t(st.node[kp]) * 2 * D : r + kV;
         const double* vw = REMAPPED ? vs + D : r + kW;
-        for (int j = 0; j < D; ++j) {
-          const double gj = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
-          for (int d = 0; d < D; ++d) {
-            ls[d][j] += vs[d] * gj;
-            lw[d][j] += vw[d] * gj;
-          }
-        }
+        add_velocity_gradient<D>(ls, vs, st, size_t(k), p);
+        add_velocity_gradient<D>(lw, vw, st, size_t(k), p);
       }
       // MUSL: move with the updated solid grid velocity, after L on the start-of-step stencil.
       if constexpr (REMAPPED)
@@ -629,12 +616,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       for (int d = 0; d < D; ++d) {
         trs += ls[d][d];
         trw += lw[d][d];
-        for (int j = 0; j < D; ++j) L[size_t(d * D + j) * kBlock + size_t(p)] = ls[d][j];
       }
+      store_velocity_gradient<D>(ls, L, p);
       // Volume, F, porosity (solid volume (1 - n) V conserved) and the storage equation.
-      const double J = det_increment<D>(ls, dt);
-      P.col(P.volume)[i] *= J;
-      if (F[0]) update_deformation_gradient<D>(F, ls, dt, p);
+      const double J = update_volume_and_deformation<D>(ls, dt, P.col(P.volume)[i], F, p);
       double& n = P.col(n_)[i];
       const double n_old = n;
       n = 1 - (1 - n) / J;

@@ -1,5 +1,7 @@
 #pragma once
 // Helpers for tests that run the real `loam` command line (regression scenes).
+#include <hdf5.h>
+
 #include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -46,6 +48,33 @@ inline std::map<std::string, std::vector<double>> read_csv_columns(
       cols[names[k]].push_back(std::stod(c));
   }
   return cols;
+}
+
+/// A dataset of an HDF5 particle frame (all components, row-major) read as `type`; empty if the
+/// frame has no such dataset (a field the frame's set does not store).
+template <class T>
+std::vector<T> read_frame_dataset(const std::filesystem::path& file, const std::string& name,
+                                  hid_t type) {
+  hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  REQUIRE(f >= 0);
+  std::vector<T> v;
+  if (H5Lexists(f, name.c_str(), H5P_DEFAULT) > 0) {
+    hid_t ds = H5Dopen2(f, name.c_str(), H5P_DEFAULT);
+    hid_t space = H5Dget_space(ds);
+    v.resize(size_t(H5Sget_simple_extent_npoints(space)));
+    if (!v.empty()) H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+    H5Sclose(space);
+    H5Dclose(ds);
+  }
+  H5Fclose(f);
+  return v;
+}
+inline std::vector<double> read_frame_doubles(const std::filesystem::path& file,
+                                              const std::string& name) {
+  return read_frame_dataset<double>(file, name, H5T_NATIVE_DOUBLE);
+}
+inline std::vector<int> read_frame_ids(const std::filesystem::path& file) {
+  return read_frame_dataset<int>(file, "id", H5T_NATIVE_INT);
 }
 
 /// A fresh, empty directory under the system temp dir, removed when the object dies.

@@ -78,12 +78,12 @@ TEST_CASE("every built-in plugin is one file named as its YAML type, in its kind
   // schemes/, plugins/<kind>/. A plugin registered by the test binary itself or loaded from a
   // library is not built-in and is skipped.
   const std::map<std::string, std::string> folder = {
-      {"material", "materials"},          {"shape_function", "shapefunctions"},
-      {"scheme", "schemes"},              {"boundary", "plugins/boundaries"},
-      {"load", "plugins/loads"},          {"damping", "plugins/damping"},
-      {"drag", "plugins/drag"},           {"generator", "plugins/generators"},
-      {"field", "plugins/fields"},        {"reference", "plugins/references"},
-      {"writer", "plugins/writers"},      {"source", "plugins/sources"},
+      {"material", "materials"},     {"shape_function", "shapefunctions"},
+      {"scheme", "schemes"},         {"boundary", "plugins/boundaries"},
+      {"load", "plugins/loads"},     {"damping", "plugins/damping"},
+      {"drag", "plugins/drag"},      {"generator", "plugins/generators"},
+      {"field", "plugins/fields"},   {"reference", "plugins/references"},
+      {"writer", "plugins/writers"}, {"source", "plugins/sources"},
       {"sink", "plugins/sinks"}};
   auto& reg = loam::Registry::instance();
   int checked = 0;
@@ -99,4 +99,21 @@ TEST_CASE("every built-in plugin is one file named as its YAML type, in its kind
     }
   }
   CHECK(checked >= 30);
+}
+
+TEST_CASE("every seedNNN config names the paper it reproduces in its first line", "[layout]") {
+  // docs/verification.md lists the papers; a config's header starts "# Paper (seed NNN):".
+  int checked = 0;
+  for (const auto& e : fs::directory_iterator(fs::path(LOAM_SOURCE_DIR) / "configs")) {
+    const std::string n = e.path().filename().string();
+    if (n.rfind("seed", 0) != 0 || e.path().extension() != ".yaml") continue;
+    std::ifstream in(e.path());
+    std::string first;
+    std::getline(in, first);
+    INFO(n << ": " << first);
+    CHECK(first.rfind("# Paper (seed " + n.substr(4, 3) + "):", 0) == 0);
+    ++checked;
+  }
+  std::printf("seed configs with their paper named: %d\n", checked);
+  CHECK(checked >= 7);
 }

@@ -3,8 +3,6 @@
 // not change the physics: the particles' trajectories may differ only by the summation order
 // of the scatter (round-off). Each set gets its own frames (<set>.xdmf, <set>_NNNNNN.h5), counts
 // in summary.json, and stores only the fields its bodies need.
-#include <hdf5.h>
-
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -54,40 +52,12 @@ std::string split_collapse(bool two_sets, const std::string& right_material = ""
          "output: {every_time: 0.5, fields: [velocity, stress, plastic_strain_eq]}\n";
 }
 
-/// A double dataset of an HDF5 frame (rows x width, row-major).
-std::vector<double> read_doubles(const fs::path& file, const std::string& name) {
-  hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  REQUIRE(f >= 0);
-  std::vector<double> v;
-  if (H5Lexists(f, name.c_str(), H5P_DEFAULT) > 0) {
-    hid_t ds = H5Dopen2(f, name.c_str(), H5P_DEFAULT);
-    hid_t space = H5Dget_space(ds);
-    v.resize(size_t(H5Sget_simple_extent_npoints(space)));
-    if (!v.empty()) H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
-    H5Sclose(space);
-    H5Dclose(ds);
-  }
-  H5Fclose(f);
-  return v;
-}
-std::vector<int> read_ids(const fs::path& file) {
-  hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  hid_t ds = H5Dopen2(f, "id", H5P_DEFAULT);
-  hid_t space = H5Dget_space(ds);
-  std::vector<int> v(size_t(H5Sget_simple_extent_npoints(space)));
-  if (!v.empty()) H5Dread(ds, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
-  H5Sclose(space);
-  H5Dclose(ds);
-  H5Fclose(f);
-  return v;
-}
-
 /// Positions (x, y) by particle id over the frame files of one output time.
 std::map<int, std::array<double, 2>> positions_by_id(const std::vector<fs::path>& frames) {
   std::map<int, std::array<double, 2>> m;
   for (const auto& f : frames) {
-    const auto x = read_doubles(f, "position");  // padded to 3 components
-    const auto id = read_ids(f);
+    const auto x = read_frame_doubles(f, "position");  // padded to 3 components
+    const auto id = read_frame_ids(f);
     for (size_t i = 0; i < id.size(); ++i) m[id[i]] = {x[3 * i], x[3 * i + 1]};
   }
   return m;
@@ -195,9 +165,9 @@ TEST_CASE("each set has its own ParaView frames and stores only its bodies' fiel
                 frames, x.find("NumberOfElements=\"400\"") != std::string::npos ? "yes" : "no");
     CHECK(frames >= 3);
     CHECK(fs::exists(last));
-    CHECK(read_ids(last).size() == 400);
+    CHECK(read_frame_ids(last).size() == 400);
     CHECK(x.find("NumberOfElements=\"400\"") != std::string::npos);
-    const bool has_eq = !read_doubles(last, "plastic_strain_eq").empty();
+    const bool has_eq = !read_frame_doubles(last, "plastic_strain_eq").empty();
     CHECK(has_eq == (set == "left"));
     CHECK((x.find("plastic_strain_eq") != std::string::npos) == (set == "left"));
   }

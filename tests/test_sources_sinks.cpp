@@ -5,8 +5,6 @@
 //   - steady outflow rate = rho v A (reference: mass conservation of a plug flow at v through
 //     the cross-section A, per unit thickness in 2D) within 1 %;
 //   - ids unique over the run; ParaView frames whose particle count changes.
-#include <hdf5.h>
-
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -54,19 +52,6 @@ CliResult run_text(const fs::path& dir, const std::string& yaml, const std::stri
   std::ofstream(dir / "run.yaml") << yaml;
   return run_loam("run " + (dir / "run.yaml").string() + " --quiet --threads 1 --out " +
                   (dir / "out").string() + " " + args);
-}
-
-std::vector<int> read_ids(const fs::path& file) {
-  hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  REQUIRE(f >= 0);
-  hid_t ds = H5Dopen2(f, "id", H5P_DEFAULT);
-  hid_t space = H5Dget_space(ds);
-  std::vector<int> v(size_t(H5Sget_simple_extent_npoints(space)));
-  if (!v.empty()) H5Dread(ds, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
-  H5Sclose(space);
-  H5Dclose(ds);
-  H5Fclose(f);
-  return v;
 }
 
 /// Least-squares slope of y against x over the samples with x in [x0, x1].
@@ -131,7 +116,7 @@ TEST_CASE("inflow -> channel -> outlet: mass balance, outflow rho v A, unique id
     char name[64];
     std::snprintf(name, sizeof name, "particles_%06d.h5", k);
     if (!fs::exists(out / name)) break;
-    const auto ids = read_ids(out / name);
+    const auto ids = read_frame_ids(out / name);
     const std::set<int> now(ids.begin(), ids.end());
     CHECK(now.size() == ids.size());
     for (int id : previous)
@@ -246,7 +231,7 @@ TEST_CASE("particles added by a source get every plugin's initial state", "[sour
       "  - {type: inflow, body: more, min: [0.0, 0], max: [0.02, 0.2], velocity: [0.1, 0]}\n"
       "time: {end: 1}\n");
   auto& P = sim->sets[0].particles;
-  const size_t n0 = 400;  // generated: 20 x 20 at spacing 0.01 m
+  const size_t n0 = 400;         // generated: 20 x 20 at spacing 0.01 m
   REQUIRE(P.size() == n0 + 40);  // filled at t = 0: the region's 2 x 20 lattice sites
   advance(*sim, 1);
   REQUIRE(P.size() == n0 + 40);  // no new layer yet (0.1 m/s for one step)

@@ -8,7 +8,7 @@
 namespace loam {
 
 template <int D>
-class Plane : public Sink<D> {
+class Plane : public SinkOnSets<D> {
  public:
   using Vec = std::array<double, D>;
   static constexpr const char* name = "plane";
@@ -18,7 +18,7 @@ class Plane : public Sink<D> {
     Schema s;
     s.vector("point", "m", "a point of the plane").required();
     s.vector("normal", "-", "normal pointing to the side whose particles are removed").required();
-    s.text("set", "remove only particles of this set (default: every set)");
+    SinkOnSets<D>::add_set_param(s);
     s.check([](const Params& p, Diagnostics& d) {
       double n2 = 0;
       for (double n : p.vec("normal")) n2 += n * n;
@@ -26,7 +26,7 @@ class Plane : public Sink<D> {
     });
     return s;
   }
-  explicit Plane(const Params& p) : params_(p) {
+  explicit Plane(const Params& p) : SinkOnSets<D>(p) {
     double n2 = 0;
     for (int d = 0; d < D; ++d) {
       x0_[size_t(d)] = p.vec("point")[size_t(d)];
@@ -35,12 +35,9 @@ class Plane : public Sink<D> {
     }
     for (auto& n : n_) n /= std::sqrt(n2);
   }
-  void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    if (params_.has("set")) set_ = sim.set_param(params_, "set", diag);
-  }
   void mark(const Simulation<D>& sim, const ParticleSet<D>& set,
             std::vector<uint8_t>& remove) const override {
-    if (set_ >= 0 && &set != &sim.sets[size_t(set_)]) return;
+    if (!this->acts_on(sim, set)) return;
     const Particles<D>& P = set.particles;
     for (size_t i = 0; i < P.size(); ++i)
       if (side(P, i) > 0) remove[i] = 1;
@@ -54,9 +51,7 @@ class Plane : public Sink<D> {
   }
 
  private:
-  Params params_;
   Vec x0_{}, n_{};
-  int set_ = -1;
   double side(const Particles<D>& P, size_t i) const {
     double s = 0;
     for (int d = 0; d < D; ++d) s += (P.col(P.position, d)[i] - x0_[size_t(d)]) * n_[size_t(d)];

@@ -5,7 +5,7 @@
 namespace loam {
 
 template <int D>
-class Region : public Sink<D> {
+class Region : public SinkOnSets<D> {
  public:
   using Vec = std::array<double, D>;
   static constexpr const char* name = "region";
@@ -14,7 +14,7 @@ class Region : public Sink<D> {
     Schema s;
     s.vector("min", "m", "lower corner of the box").required();
     s.vector("max", "m", "upper corner of the box").required();
-    s.text("set", "remove only particles of this set (default: every set)");
+    SinkOnSets<D>::add_set_param(s);
     s.check([](const Params& p, Diagnostics& d) {
       for (size_t i = 0; i < p.vec("min").size(); ++i)
         if (p.vec("max")[i] <= p.vec("min")[i])
@@ -22,16 +22,13 @@ class Region : public Sink<D> {
     });
     return s;
   }
-  explicit Region(const Params& p) : params_(p) {
+  explicit Region(const Params& p) : SinkOnSets<D>(p) {
     for (int d = 0; d < D; ++d)
       lo_[size_t(d)] = p.vec("min")[size_t(d)], hi_[size_t(d)] = p.vec("max")[size_t(d)];
   }
-  void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    if (params_.has("set")) set_ = sim.set_param(params_, "set", diag);
-  }
   void mark(const Simulation<D>& sim, const ParticleSet<D>& set,
             std::vector<uint8_t>& remove) const override {
-    if (set_ >= 0 && &set != &sim.sets[size_t(set_)]) return;
+    if (!this->acts_on(sim, set)) return;
     const Particles<D>& P = set.particles;
     for (size_t i = 0; i < P.size(); ++i) {
       bool in = true;
@@ -49,9 +46,7 @@ class Region : public Sink<D> {
   }
 
  private:
-  Params params_;
   Vec lo_{}, hi_{};
-  int set_ = -1;
 };
 
 LOAM_REGISTER(Sink, Region)

@@ -1,0 +1,117 @@
+#pragma once
+// Building blocks of an explicit MPM step, shared by the schemes so that each scheme's step()
+// reads as a list of named phases (Karamelo's MUSL::run, ExaMPM's step()): per-thread block
+// scratch, grid zeroing and node loops, the FLIP/PIC blend of the grid-to-particle update, the
+// velocity gradient L = sum_I v_I (x) grad N_I, and the volume and deformation-gradient update
+// V <- det(I + L dt) V, F <- (I + L dt) F. Each is an inline function on one particle or one
+// stencil entry, so a scheme's fused loops stay fused (one pass over the stencil).
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "particles.hpp"
+#include "shape_function.hpp"
+#include "tensor.hpp"
+#include "thread_scratch.hpp"
+
+namespace loam {
+
+/// What every scheme's block loop needs per thread: the stencil of the block, the velocity
+/// gradients of the block in MaterialBatch layout (L[(i*D + j)*kBlock + p]), and the largest
+/// particle speed squared seen in the step. A scheme derives from it for its own buffers.
+template <int D>
+struct alignas(64) BlockScratch {
+  StencilBlock<D> stencil;
+  std::vector<double> L;
+  double max_v2 = 0;
+};
+
+/// One scratch per thread, sized for `nodes_per_particle` stencil entries; `init` sizes what a
+/// derived scratch adds.
+template <class S, int D = decltype(S::stencil)::dimension, class Init>
+std::vector<std::unique_ptr<S>> make_block_scratch(int threads, int nodes_per_particle,
+                                                   Init&& init) {
+  return per_thread_scratch<S>(threads, [&](S& s) {
+    s.stencil.allocate(nodes_per_particle);
+    s.L.assign(size_t(D * D * kBlock), 0.0);
+    init(s);
+  });
+}
+
+template <class S>
+void reset_max_speed(std::vector<std::unique_ptr<S>>& scratch) {
+  for (auto& s : scratch) s->max_v2 = 0;
+}
+/// The largest particle speed of the step, over all threads.
+template <class S>
+double max_speed(const std::vector<std::unique_ptr<S>>& scratch) {
+  double m = 0;
+  for (const auto& s : scratch) m = std::max(m, s->max_v2);
+  return std::sqrt(m);
+}
+
+/// Zero a nodal array on all threads (first-touch friendly, static schedule).
+inline void zero_nodes(std::vector<double>& v, int threads) {
+  const long n = long(v.size());
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (long i = 0; i < n; ++i) v[size_t(i)] = 0.0;
+}
+
+/// f(node) for every node, in parallel (static schedule).
+template <class F>
+void for_each_node(size_t num_nodes, int threads, F&& f) {
+  const long n = long(num_nodes);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (long i = 0; i < n; ++i) f(size_t(i));
+}
+
+/// The FLIP/PIC blend of the particle velocity update: FLIP adds the interpolated grid
+/// acceleration to the particle's own velocity (no dissipation, noisy where nodes are nearly
+/// empty), PIC takes the interpolated grid velocity (smooth, dissipative); `flip` in [0, 1].
+inline double flip_pic(double flip, double v, double dt, double a_grid, double v_grid) {
+  return flip * (v + dt * a_grid) + (1.0 - flip) * v_grid;
+}
+
+/// Stencil entry kp of particle p (kp = k * kBlock + p) adds v_I (x) grad N_I to l.
+template <int D>
+inline void add_velocity_gradient(double (&l)[D][D], const double* v_node,
+                                  const StencilBlock<D>& st, size_t k, int p) {
+  for (int j = 0; j < D; ++j) {
+    const double gj = st.grad[(k * D + size_t(j)) * kBlock + size_t(p)];
+    for (int i = 0; i < D; ++i) l[i][j] += v_node[i] * gj;
+  }
+}
+
+/// Store particle p's velocity gradient in the block layout the materials read.
+template <int D>
+inline void store_velocity_gradient(const double (&l)[D][D], double* L, int p) {
+  for (int i = 0; i < D; ++i)
+    for (int j = 0; j < D; ++j) L[size_t(i * D + j) * kBlock + size_t(p)] = l[i][j];
+}
+
+/// The columns of the deformation gradient from particle b on, or nulls when no plugin
+/// requested F (Simulation::deformation_gradient < 0): then it costs nothing.
+template <int D>
+std::array<double*, D * D> deformation_gradient_block(Particles<D>& P, int handle, size_t b) {
+  std::array<double*, D * D> F{};
+  if (handle >= 0)
+    for (int c = 0; c < D * D; ++c) F[size_t(c)] = P.col(handle, c) + b;
+  return F;
+}
+
+/// V <- det(I + L dt) V and, when F is stored, F <- (I + L dt) F for particle p of the block;
+/// returns the volume ratio J = det(I + L dt).
+template <int D>
+inline double update_volume_and_deformation(const double (&l)[D][D], double dt, double& V,
+                                            const std::array<double*, D * D>& F, int p) {
+  const double J = det_increment<D>(l, dt);
+  V *= J;
+  if (F[0]) update_deformation_gradient<D>(F, l, dt, p);
+  return J;
+}
+
+}  // namespace loam
