@@ -1,0 +1,89 @@
+#pragma once
+// Internal to the runner, included only by runner.cpp and run_output.cpp: one run of a validated
+// configuration (Run<D>), its probes and the CSV files it writes. runner.cpp defines the loop and
+// summary.json, run_output.cpp the output directory, the output checks, frames, probes and history.
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "runner.hpp"
+#include "simulation.hpp"
+#include "writer.hpp"
+
+namespace loam {
+namespace detail {
+
+namespace fs = std::filesystem;
+
+/// A CSV written under a temporary name and renamed when complete.
+class CsvFile {
+ public:
+  void open(const fs::path& path) {
+    final_ = path;
+    tmp_ = path;
+    tmp_ += ".tmp";
+    out_.open(tmp_);
+    out_.precision(12);
+  }
+  std::ofstream& out() { return out_; }
+  void close() {
+    if (!out_.is_open()) return;
+    out_.close();
+    fs::rename(tmp_, final_);
+  }
+
+ private:
+  fs::path final_, tmp_;
+  std::ofstream out_;
+};
+
+template <int D>
+struct Probe {
+  std::string name;
+  bool on_node = false;
+  int set = 0;
+  uint32_t particle_id = 0;
+  size_t node = 0;
+  std::vector<std::string> fields;
+  long every = 1;
+  CsvFile csv;
+};
+
+template <int D>
+class Run {
+ public:
+  Run(const LoadedConfig& cfg, const RunOptions& opt) : cfg_(cfg), opt_(opt) {}
+
+  RunResult execute(bool check_only);
+
+ private:
+  const LoadedConfig& cfg_;
+  const RunOptions& opt_;
+  std::unique_ptr<Simulation<D>> sim_;
+  std::unique_ptr<Writer<D>> writer_;
+  std::vector<int> frame_fields_;
+  std::vector<Probe<D>> probes_;
+  CsvFile history_;
+  fs::path dir_;
+  int displacement_ = -1, initial_position_ = -1;
+  long frames_ = 0;
+
+  // Output (run_output.cpp).
+  void check_outputs(Diagnostics& diag);
+  std::string prepare_directory();
+  void refresh_derived();
+  void open_outputs();
+  void sample_probes(bool force);
+  void write_history();
+  bool exchanges_particles() const { return !sim_->sources.empty() || !sim_->sinks.empty(); }
+  void write_frame(const std::string& label);
+
+  // The loop and summary.json (runner.cpp).
+  nlohmann::json base_summary() const;
+  RunResult loop();
+};
+
+}  // namespace detail
+}  // namespace loam

@@ -1,0 +1,261 @@
+// The output of a run: the output fields and probes checked against the model, the output
+// directory, frames (through the writer plugin, derived fields such as displacement refreshed),
+// the probe CSVs and history.csv. The loop that calls these is in runner.cpp.
+#include "run.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "registry.hpp"
+
+namespace loam {
+namespace detail {
+
+namespace {
+
+/// Output fields that are not stored but derived when written.
+bool derived_field(const std::string& name) {
+  return name == "displacement";
+}
+
+}  // namespace
+
+template <int D>
+void Run<D>::check_outputs(Diagnostics& diag) {
+  // Every set has the same field layout; a name is known if some set stores it.
+  const Particles<D>& p = sim_->sets[0].particles;
+  std::vector<std::string> known;
+  for (int f = 0; f < p.num_fields(); ++f) {
+    bool stored = false;
+    for (const auto& s : sim_->sets) stored = stored || s.particles.has(f);
+    if (stored) known.push_back(p.info(f).name);
+  }
+  known.push_back("displacement");
+  auto check_name = [&](const Params& sec, size_t i, const std::string& name, bool node) {
+    std::vector<std::string> options = known;
+    if (node) {
+      options.clear();
+      for (const auto& g : sim_->scheme->grid_fields()) options.push_back(g.name);
+    }
+    if (std::find(options.begin(), options.end(), name) != options.end()) return true;
+    std::string path = sec.path("fields") + "." + std::to_string(i);
+    diag.error(sec.where("fields", i), path,
+               "unknown " + std::string(node ? "node" : "particle") + " field '" + name + "'" +
+                   suggest(name, options, "available fields"));
+    return false;
+  };
+  const Params& out = cfg_.params.section("output");
+  const auto& names = out.strings("fields");
+  bool need_disp = false;
+  for (size_t i = 0; i < names.size(); ++i)
+    if (check_name(out, i, names[i], false)) {
+      if (derived_field(names[i]))
+        need_disp = true;
+      else if (names[i] != "position")
+        frame_fields_.push_back(p.find(names[i]));  // one layout: valid in every set
+    }
+  for (const auto& pr : cfg_.params.list("probes")) {
+    Probe<D> probe;
+    probe.name = pr.text("name");
+    probe.every = pr.integer("every_steps");
+    probe.on_node = pr.has("node");
+    if (pr.has("node") == pr.has("particle_near")) {
+      diag.error(pr.where(), pr.path(), "give exactly one of 'particle_near' or 'node'");
+      continue;
+    }
+    const auto& f = pr.strings("fields");
+    for (size_t i = 0; i < f.size(); ++i)
+      if (check_name(pr, i, f[i], probe.on_node)) {
+        probe.fields.push_back(f[i]);
+        if (derived_field(f[i])) need_disp = true;
+      }
+    if (probe.on_node) {
+      size_t idx = 0;
+      const auto& ijk = pr.vec("node");
+      for (int d = 0; d < D; ++d) {
+        long k = std::lround(ijk[size_t(d)]);
+        if (k < 0 || k >= sim_->grid.nodes[d] || std::fabs(ijk[size_t(d)] - double(k)) > 1e-9) {
+          diag.error(pr.where("node"), pr.path("node"),
+                     "node index " + format_number(ijk[size_t(d)]) + " along " + "xyz"[d] +
+                         " is not an integer in [0, " + std::to_string(sim_->grid.nodes[d] - 1) +
+                         "]");
+        }
+        idx += size_t(std::max(0L, k)) * size_t(sim_->grid.node_stride[d]);
+      }
+      probe.node = idx;
+    } else {
+      probe.set = sim_->set_param(pr, "set", diag);
+      if (probe.set < 0) continue;
+      const Particles<D>& ps = sim_->sets[size_t(probe.set)].particles;
+      for (const auto& name : probe.fields)
+        if (!derived_field(name) && !ps.has(ps.find(name)))
+          diag.error(pr.where("fields"), pr.path("fields"),
+                     "particle set '" + sim_->sets[size_t(probe.set)].name +
+                         "' does not store field '" + name + "'");
+      if (ps.size() == 0) {
+        diag.error(pr.where("set"), pr.path("set"), "the particle set has no particles");
+        continue;
+      }
+      const auto& target = pr.vec("particle_near");
+      double best = 1e300;
+      for (size_t i = 0; i < ps.size(); ++i) {
+        double r2 = 0;
+        for (int d = 0; d < D; ++d) {
+          double dx = ps.col(ps.position, d)[i] - target[size_t(d)];
+          r2 += dx * dx;
+        }
+        if (r2 < best) best = r2, probe.particle_id = ps.id[i];
+      }
+    }
+    probes_.push_back(std::move(probe));
+  }
+  for (size_t i = 0; i < probes_.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (probes_[i].name == probes_[j].name)
+        diag.error(cfg_.params.where("probes"), "probes." + std::to_string(i) + ".name",
+                   "duplicate probe name '" + probes_[i].name + "'");
+  if (need_disp) {
+    initial_position_ = sim_->request_field(
+        {"initial_position", D, "m", "position at t = 0", Particles<D>::axis_names()});
+    displacement_ = sim_->request_field(
+        {"displacement", D, "m", "position minus initial position", Particles<D>::axis_names()});
+    for (auto& s : sim_->sets) {
+      Particles<D>& ps = s.particles;
+      for (int d = 0; d < D; ++d)
+        std::copy(ps.col(ps.position, d), ps.col(ps.position, d) + ps.size(),
+                  ps.col(initial_position_, d));
+    }
+    for (const auto& n : names)
+      if (n == "displacement") frame_fields_.push_back(displacement_);
+  }
+}
+
+template <int D>
+std::string Run<D>::prepare_directory() {
+  dir_ = opt_.out_dir.empty() ? fs::path("results") / cfg_.name : fs::path(opt_.out_dir);
+  std::error_code ec;
+  if (fs::exists(dir_) && !fs::is_directory(dir_))
+    return "output path " + dir_.string() + " is a file";
+  if (fs::exists(dir_) && !fs::is_empty(dir_)) {
+    if (!opt_.overwrite)
+      return "output directory " + dir_.string() +
+             " is not empty; pass --overwrite to replace its results or --out DIR";
+    // Remove only what loam writes, never foreign files.
+    for (const auto& e : fs::directory_iterator(dir_)) {
+      std::string n = e.path().filename().string(), ext = e.path().extension().string();
+      if (ext == ".h5" || ext == ".xdmf" || ext == ".csv" || ext == ".tmp" || n == "summary.json")
+        fs::remove(e.path(), ec);
+    }
+  }
+  fs::create_directories(dir_, ec);
+  if (ec) return "cannot create output directory " + dir_.string() + ": " + ec.message();
+  return "";
+}
+
+template <int D>
+void Run<D>::refresh_derived() {
+  if (displacement_ < 0) return;
+  for (auto& s : sim_->sets) {
+    Particles<D>& p = s.particles;
+    for (int d = 0; d < D; ++d) {
+      const double* x = p.col(p.position, d);
+      const double* x0 = p.col(initial_position_, d);
+      double* u = p.col(displacement_, d);
+      for (size_t i = 0; i < p.size(); ++i) u[i] = x[i] - x0[i];
+    }
+  }
+}
+
+template <int D>
+void Run<D>::open_outputs() {
+  writer_ = Registry::instance().create<Writer, D>(cfg_.params.section("output").section("writer"));
+  writer_->open(dir_.string(), *sim_, frame_fields_);
+  history_.open(dir_ / "history.csv");
+  history_.out() << "step,time,dt,kinetic_energy,strain_energy,gravity_energy,total_energy";
+  for (int d = 0; d < D; ++d)
+    history_.out() << ",momentum_"
+                   << "xyz"[d];
+  if (exchanges_particles()) history_.out() << ",particles,mass_created,mass_removed";
+  history_.out() << "\n";
+  for (auto& pr : probes_) {
+    pr.csv.open(dir_ / ("probe_" + pr.name + ".csv"));
+    pr.csv.out() << "step,time";
+    for (const auto& f : pr.fields) {
+      int nc = 1;
+      std::vector<std::string> names;
+      if (pr.on_node) {
+        for (const auto& g : sim_->scheme->grid_fields())
+          if (g.name == f) nc = g.components;
+        for (int c = 0; c < nc; ++c) names.push_back(nc > 1 ? std::string(1, "xyz"[c]) : "");
+      } else {
+        const Particles<D>& p = sim_->sets[size_t(pr.set)].particles;
+        int h = f == "displacement" ? displacement_ : p.find(f);
+        nc = p.info(h).components;
+        names = p.info(h).component_names;
+      }
+      for (int c = 0; c < nc; ++c)
+        pr.csv.out() << "," << f << (nc > 1 ? "_" + names[size_t(c)] : "");
+    }
+    pr.csv.out() << "\n";
+  }
+}
+
+template <int D>
+void Run<D>::sample_probes(bool force) {
+  for (auto& pr : probes_) {
+    if (!force && sim_->step % pr.every != 0) continue;
+    auto& o = pr.csv.out();
+    o << sim_->step << "," << sim_->time;
+    if (pr.on_node) {
+      for (const auto& f : pr.fields)
+        for (const auto& g : sim_->scheme->grid_fields())
+          if (g.name == f)
+            for (int c = 0; c < g.components; ++c)
+              o << "," << g.base[pr.node * size_t(g.stride) + size_t(g.offset + c)];
+    } else {
+      const ParticleSet<D>& set = sim_->sets[size_t(pr.set)];
+      const Particles<D>& p = set.particles;
+      size_t i = set.index_of(pr.particle_id);
+      for (const auto& f : pr.fields) {
+        if (f == "displacement") {
+          for (int d = 0; d < D; ++d)
+            o << "," << p.col(p.position, d)[i] - p.col(initial_position_, d)[i];
+          continue;
+        }
+        int h = p.find(f);
+        for (int c = 0; c < p.info(h).components; ++c) o << "," << p.col(h, c)[i];
+      }
+    }
+    o << "\n";
+  }
+}
+
+template <int D>
+void Run<D>::write_history() {
+  Energies e = sim_->energies();
+  auto& o = history_.out();
+  double strain = std::isnan(e.strain) ? 0.0 : e.strain;
+  o << sim_->step << "," << sim_->time << "," << sim_->dt << "," << e.kinetic << "," << e.strain
+    << "," << e.gravity << "," << e.kinetic + strain + e.gravity;
+  for (double m : e.momentum) o << "," << m;
+  if (exchanges_particles())
+    o << "," << sim_->num_particles() << "," << sim_->mass_created << "," << sim_->mass_removed;
+  o << "\n";
+}
+
+template <int D>
+void Run<D>::write_frame(const std::string& label) {
+  refresh_derived();
+  writer_->write(*sim_, label);
+  ++frames_;
+}
+
+// The class is instantiated once, here (`template class`); runner.cpp instantiates the members it
+// defines (execute, base_summary, loop) where it uses them.
+template class Run<1>;
+template class Run<2>;
+template class Run<3>;
+
+}  // namespace detail
+}  // namespace loam

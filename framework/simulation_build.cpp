@@ -1,0 +1,353 @@
+// Building a Simulation<D> from a validated config: grid, plugins, particle sets, bodies generated
+// into their sets, initial fields, plugin set-up and the checks of the model before the first step
+// (every error at once). The runtime services are in simulation.cpp.
+#include "simulation.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "registry.hpp"
+
+namespace loam {
+
+template <int D>
+Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag) : config(cfg) {
+  threads = std::max(1, num_threads);
+  // Parallel loops without an explicit num_threads (e.g. in plugins) follow --threads too.
+  omp_set_num_threads(threads);
+  build_grid(config.section("grid"), diag);
+  if (!diag.ok()) return;
+  const auto& g = config.vec("gravity");
+  for (int d = 0; d < D; ++d) gravity[size_t(d)] = g[size_t(d)];
+  const Params& t = config.section("time");
+  end_time = t.real("end");
+  cfl = t.real("cfl");
+  fixed_dt = t.has("dt") ? t.real("dt") : 0.0;
+  max_steps = long(t.integer("max_steps"));
+  const Params& num = config.section("numerics");
+  sort_every = int(num.integer("sort_every"));
+  check_every = long(num.integer("check_every"));
+  mass_tolerance = num.real("mass_tolerance");
+  for (const auto& s : config.list("selections")) {
+    Vec lo{}, hi{};
+    for (int d = 0; d < D; ++d)
+      lo[size_t(d)] = s.vec("min")[size_t(d)], hi[size_t(d)] = s.vec("max")[size_t(d)];
+    selections_.push_back({s.text("name"), {lo, hi}});
+  }
+  // From here on, keep checking after an error wherever the rest does not depend on it, so that
+  // one run reports every problem at once.
+  create_plugins(diag);
+  create_sets(diag);
+  const size_t errors_before = diag.errors().size();
+  generate_bodies(diag);
+  const bool particles_ok = diag.errors().size() == errors_before;
+  if (!particles_ok)
+    for (auto& s : sets) s.particles.resize(0);  // check the remaining set-up on an empty model
+  // Plugins see the generated particles in set-up (e.g. to select faces or request fields).
+  shape->setup(*this, diag);
+  scheme->setup(*this, diag);
+  for (size_t m = 0; m < materials.size(); ++m) materials[m]->setup(*this, int(m), diag);
+  if (particles_ok) initialize_fields(diag);
+  bool particle_loads = false;
+  for (auto& l : loads) particle_loads = particle_loads || l->uses_particle_forces();
+  if (particle_loads)
+    external_force = request_field(
+        {"external_force", D, "N", "applied external force", Particles<D>::axis_names()});
+  sort();
+  for (auto& s : sets)
+    for (size_t m = 0; m < materials.size(); ++m) {
+      const auto& r = s.partition.material_ranges[m];
+      if (r.end > r.begin) materials[m]->initialize(s.particles, r.begin, r.end);
+    }
+  for (auto& b : boundaries) b->setup(*this, diag);
+  model_checked = true;
+  if (!particles_ok) return;  // loads and references select particles
+  for (auto& l : loads) l->setup(*this, diag);
+  for (auto& p : sources) p->setup(*this, diag);
+  for (auto& p : sinks) p->setup(*this, diag);
+  if (diag.ok()) check_sources_and_sinks(diag);
+  if (reference) reference->setup(*this, diag);
+  if (!diag.ok()) return;
+  // The sources act at t = 0 too (an inlet starts filled); their particles count as created.
+  initial_mass = total_mass();
+  next_id_ = uint32_t(num_particles());
+  for (auto& p : sources) p->apply(*this, time);
+  for (auto& s : sets)
+    if (s.resized) sort(s);
+  double v2 = 0;
+  for (const auto& s : sets)
+    for (int d = 0; d < D; ++d) {
+      const double* v = s.particles.col(s.particles.velocity, d);
+      for (size_t i = 0; i < s.size(); ++i) v2 = std::max(v2, v[i] * v[i]);
+    }
+  max_speed = std::sqrt(v2);
+  // Step budget: a stiff set-up (e.g. K_w / n with a porosity near 0) can make the stable time
+  // step so small that the run would never finish; say so before writing anything.
+  const double dt0 = stable_dt();
+  if (end_time / dt0 > double(max_steps))
+    diag.error(t.where("end"), t.path("end"),
+               "the stable time step at the start is " + format_number(dt0) + " s, so " +
+                   format_number(end_time) + " s needs about " +
+                   format_number(std::ceil(end_time / dt0)) +
+                   " steps, more than time.max_steps = " + std::to_string(max_steps) +
+                   " (a stiff material or pore fluid, e.g. K_w / n with a tiny porosity, or a "
+                   "fine grid); raise time.max_steps if this is intended");
+}
+
+template <int D>
+void Simulation<D>::create_sets(Diagnostics& diag) {
+  for (const auto& decl : scheme->particle_sets()) {
+    sets.emplace_back();
+    sets.back().name = decl.name;
+  }
+  const auto& bl = config.list("bodies");
+  for (size_t b = 0; b < bl.size(); ++b) {
+    const int s = set_param(bl[b], "set", diag);
+    body_set_.push_back(std::max(s, 0));
+    if (s >= 0) sets[size_t(s)].bodies.push_back(int(b));
+  }
+}
+
+template <int D>
+void Simulation<D>::build_grid(const Params& g, Diagnostics& diag) {
+  Vec o{}, e{}, h{};
+  for (int d = 0; d < D; ++d) {
+    o[size_t(d)] = g.vec("origin")[size_t(d)];
+    e[size_t(d)] = g.vec("extent")[size_t(d)];
+    h[size_t(d)] = g.vec("cell_size")[size_t(d)];
+    double ratio = e[size_t(d)] / h[size_t(d)];
+    const char* axis = "xyz" + d;
+    if (ratio < 1 - 1e-6) {  // not even one whole cell
+      diag.error(g.where("cell_size"), g.path("cell_size"),
+                 std::string("the grid has zero cells along ") + axis[0] + " (extent " +
+                     format_number(e[size_t(d)]) + " m < cell_size " + format_number(h[size_t(d)]) +
+                     " m)");
+    } else if (std::fabs(ratio - std::round(ratio)) > 1e-6 * ratio) {
+      spdlog::warn(
+          "grid: extent along {} is not a multiple of cell_size; using {} cells of {:.6g} m",
+          axis[0], std::lround(ratio), e[size_t(d)] / double(std::lround(ratio)));
+    }
+  }
+  if (diag.ok()) grid.init(o, e, h);
+}
+
+template <int D>
+void Simulation<D>::create_plugins(Diagnostics& diag) {
+  Registry& reg = Registry::instance();
+  shape = reg.create<ShapeFunction, D>(config.section("shape_function"));
+  scheme = reg.create<Scheme, D>(config.section("scheme"));
+  for (const auto& b : config.list("boundaries")) boundaries.push_back(reg.create<Boundary, D>(b));
+  for (const auto& l : config.list("loads")) loads.push_back(reg.create<Load, D>(l));
+  for (const auto& p : config.list("sources")) sources.push_back(reg.create<Source, D>(p));
+  for (const auto& p : config.list("sinks")) sinks.push_back(reg.create<Sink, D>(p));
+  if (config.has("damping")) damping = reg.create<Damping, D>(config.section("damping"));
+  if (config.has("verify")) reference = reg.create<Reference, D>(config.section("verify"));
+  const auto& bl = config.list("bodies");
+  for (size_t i = 0; i < bl.size(); ++i) {
+    for (size_t j = 0; j < i; ++j)
+      if (bl[j].text("name") == bl[i].text("name"))
+        diag.error(bl[i].where("name"), bl[i].path("name"),
+                   "duplicate body name '" + bl[i].text("name") + "'");
+    materials.push_back(reg.create<Material, D>(bl[i].section("material")));
+  }
+}
+
+template <int D>
+void Simulation<D>::generate_bodies(Diagnostics& diag) {
+  Registry& reg = Registry::instance();
+  const auto& bl = config.list("bodies");
+  const size_t errors_before = diag.errors().size();
+  std::vector<Vec> xs;
+  std::vector<uint16_t> owner;
+  std::vector<double> vols;
+  for (size_t b = 0; b < bl.size(); ++b) {
+    const Params& bp = bl[b];
+    if (!bp.has("generator")) {  // starts empty: its particles come from a source
+      Body body;
+      body.name = bp.text("name");
+      body.params = bp;
+      body.first_id = xs.size();
+      body.lower.assign(D, 0.0);
+      body.upper.assign(D, 0.0);
+      for (int d = 0; d < D; ++d)
+        body.spacing.push_back(grid.cell[size_t(d)] / double(bp.integer("particles_per_cell")));
+      bodies.push_back(std::move(body));
+      continue;
+    }
+    auto gen = reg.create<Generator, D>(bp.section("generator"));
+    if (std::string problem = gen->check(); !problem.empty()) {
+      diag.error(bp.where("generator"), bp.path("generator"), problem);
+      continue;
+    }
+    Vec lo = gen->lower(), hi = gen->upper();
+    bool inside = true;
+    for (int d = 0; d < D; ++d)
+      inside = inside && lo[size_t(d)] >= grid.origin[size_t(d)] - 1e-12 &&
+               hi[size_t(d)] <= grid.upper(d) + 1e-12;
+    if (!inside) {
+      std::ostringstream s;
+      s << "particles outside the grid: the body spans [";
+      for (int d = 0; d < D; ++d) s << (d ? ", " : "") << format_number(lo[size_t(d)]);
+      s << "] to [";
+      for (int d = 0; d < D; ++d) s << (d ? ", " : "") << format_number(hi[size_t(d)]);
+      s << "] but the grid spans [";
+      for (int d = 0; d < D; ++d) s << (d ? ", " : "") << format_number(grid.origin[size_t(d)]);
+      s << "] to [";
+      for (int d = 0; d < D; ++d) s << (d ? ", " : "") << format_number(grid.upper(d));
+      s << "]";
+      diag.error(bp.where("generator"), bp.path("generator"), s.str());
+      continue;
+    }
+    const int ppc = int(bp.integer("particles_per_cell"));
+    Body body;
+    body.name = bp.text("name");
+    body.params = bp;
+    body.first_id = xs.size();
+    Vec s{};
+    double vol = 1;
+    std::array<long, D> i0{}, i1{};
+    for (int d = 0; d < D; ++d) {
+      s[size_t(d)] = grid.cell[size_t(d)] / ppc;
+      vol *= s[size_t(d)];
+      // Lattice points origin + (i + 1/2) s inside [lo, hi].
+      i0[size_t(d)] =
+          long(std::ceil((lo[size_t(d)] - grid.origin[size_t(d)]) / s[size_t(d)] - 0.5 - 1e-9));
+      i1[size_t(d)] =
+          long(std::floor((hi[size_t(d)] - grid.origin[size_t(d)]) / s[size_t(d)] - 0.5 + 1e-9));
+    }
+    std::array<long, D> i = i0;
+    bool empty_range = false;
+    for (int d = 0; d < D; ++d) empty_range = empty_range || i1[size_t(d)] < i0[size_t(d)];
+    Vec plo, phi;
+    plo.fill(1e300);
+    phi.fill(-1e300);
+    while (!empty_range) {
+      Vec x{};
+      for (int d = 0; d < D; ++d)
+        x[size_t(d)] = grid.origin[size_t(d)] + (double(i[size_t(d)]) + 0.5) * s[size_t(d)];
+      if (gen->contains(x)) {
+        xs.push_back(x);
+        owner.push_back(uint16_t(b));
+        vols.push_back(vol);
+        for (int d = 0; d < D; ++d) {
+          plo[size_t(d)] = std::min(plo[size_t(d)], x[size_t(d)] - 0.5 * s[size_t(d)]);
+          phi[size_t(d)] = std::max(phi[size_t(d)], x[size_t(d)] + 0.5 * s[size_t(d)]);
+        }
+      }
+      int d = 0;
+      while (d < D && ++i[size_t(d)] > i1[size_t(d)]) i[size_t(d)] = i0[size_t(d)], ++d;
+      if (d == D) break;
+    }
+    body.count = xs.size() - body.first_id;
+    if (body.count == 0) {
+      diag.error(bp.where("generator"), bp.path("generator"),
+                 "the generator produced no particles (region smaller than the particle spacing " +
+                     format_number(s[0]) + " m?)");
+      continue;
+    }
+    body.lower.assign(plo.begin(), plo.end());
+    body.upper.assign(phi.begin(), phi.end());
+    body.spacing.assign(s.begin(), s.end());
+    bodies.push_back(std::move(body));
+  }
+  if (diag.errors().size() != errors_before) return;
+  if (xs.size() > size_t(UINT32_MAX)) {
+    diag.error(config.where("bodies"), "bodies", "more than 2^32 particles");
+    return;
+  }
+  // Each set holds its bodies' particles in body order; ids count over all bodies.
+  for (auto& body : bodies) body.set = body_set_[size_t(&body - bodies.data())];
+  for (size_t si = 0; si < sets.size(); ++si) {
+    Particles<D>& P = sets[si].particles;
+    size_t n = 0;
+    for (auto& body : bodies)
+      if (body.set == int(si)) body.first_index = n, n += body.count;
+    P.resize(n);
+    for (const auto& body : bodies) {
+      if (body.set != int(si)) continue;
+      for (size_t k = 0; k < body.count; ++k) {
+        const size_t i = body.first_index + k, g = body.first_id + k;
+        P.id[i] = uint32_t(g);
+        P.material[i] = owner[g];
+        P.body[i] = owner[g];
+        for (int d = 0; d < D; ++d) P.col(P.position, d)[i] = xs[g][size_t(d)];
+        P.col(P.volume)[i] = vols[g];
+        P.col(P.mass)[i] = vols[g] * materials[owner[g]]->density();
+      }
+    }
+    sets[si].invalidate_index();
+  }
+  // Initial velocity and stress fields.
+  std::vector<double> value(size_t(Particles<D>::NS));
+  for (size_t b = 0; b < bl.size(); ++b) {
+    const Params& bp = bl[b];
+    Particles<D>& P = sets[size_t(bodies[b].set)].particles;
+    for (auto [key, field] : {std::pair<const char*, int>{"velocity", P.velocity},
+                              std::pair<const char*, int>{"stress", P.stress}}) {
+      if (!bp.has(key)) continue;
+      auto f = reg.create<Field, D>(bp.section(key));
+      const int nc = P.info(field).components;
+      for (size_t k = 0; k < bodies[b].count; ++k) {
+        f->value(xs[bodies[b].first_id + k], value.data());
+        for (int c = 0; c < nc; ++c) P.col(field, c)[bodies[b].first_index + k] = value[size_t(c)];
+      }
+    }
+  }
+}
+
+template <int D>
+void Simulation<D>::initialize_fields(Diagnostics& diag) {
+  // Before the first sort a body's particles are one index range of its set.
+  const auto& bl = config.list("bodies");
+  for (size_t b = 0; b < bl.size() && b < bodies.size(); ++b)
+    for (const Params& e : bl[b].list("initial")) {
+      Particles<D>& particles = sets[size_t(bodies[b].set)].particles;
+      const std::string name = e.text("field");
+      const int h = particles.has(particles.find(name)) ? particles.find(name) : -1;
+      // Scalar: one component without component names (1D vectors have one component too).
+      auto scalar = [&](int k) {
+        return particles.info(k).components == 1 && particles.info(k).component_names.empty();
+      };
+      if (h < 0 || !scalar(h)) {
+        std::vector<std::string> scalars;
+        for (int k = 0; k < particles.num_fields(); ++k)
+          if (particles.has(k) && scalar(k)) scalars.push_back(particles.info(k).name);
+        diag.error(e.where("field"), e.path("field"),
+                   (h < 0 ? "no particle field '" : "'") + name +
+                       (h < 0 ? "'" : "' is not a scalar field") +
+                       " in this run; scalar fields: " + join(scalars, ", "));
+        continue;
+      }
+      auto f = Registry::instance().create<Field, D>(e.section("value"));
+      std::array<double, D> x{};
+      for (size_t i = bodies[b].first_index; i < bodies[b].first_index + bodies[b].count; ++i) {
+        for (int d = 0; d < D; ++d) x[size_t(d)] = particles.col(particles.position, d)[i];
+        f->value(x, particles.col(h) + i);
+      }
+    }
+}
+
+template <int D>
+void Simulation<D>::check_sources_and_sinks(Diagnostics& diag) {
+  const auto& sp = config.list("sources");
+  const auto& kp = config.list("sinks");
+  for (size_t i = 0; i < sources.size(); ++i) {
+    Vec lo{}, hi{};
+    sources[i]->region(lo, hi);
+    for (size_t k = 0; k < sinks.size(); ++k)
+      if (sinks[k]->overlaps(lo, hi))
+        diag.error(kp[k].where(), kp[k].path(),
+                   "the sink overlaps the region of " + sp[i].path() +
+                       ": it would remove the particles the source creates");
+  }
+}
+
+// The class is instantiated once, in simulation.cpp (`template class`); the constructor is defined
+// here, so it is instantiated here (the private helpers above with it).
+template Simulation<1>::Simulation(const Params&, int, Diagnostics&);
+template Simulation<2>::Simulation(const Params&, int, Diagnostics&);
+template Simulation<3>::Simulation(const Params&, int, Diagnostics&);
+
+}  // namespace loam
