@@ -178,7 +178,8 @@ class SinglePhase : public Scheme<D> {
   }
 
   /// Grid-to-particle velocity update (FLIP/PIC blend). With REMAP, scatter the new particle
-  /// momentum into vel_ (MUSL). With MOVE, also move particles with the updated grid velocity.
+  /// momentum into vel_ (MUSL). With MOVE, also move particles with the updated grid velocity
+  /// (never across a held face: Simulation::held_faces).
   template <int NPP, bool REMAP, bool MOVE>
   void update_velocity(Simulation<D>& sim, double dt, size_t b, int count, int thread) {
     Particles<D>& P = sim.particles;
@@ -211,7 +212,7 @@ class SinglePhase : public Scheme<D> {
         double& vp = v[size_t(d)][p];
         vp = flip * (vp + dt * a[d]) + (1.0 - flip) * vn[d];
         v2 += vp * vp;
-        if constexpr (MOVE) x[size_t(d)][p] += dt * vn[d];
+        if constexpr (MOVE) x[size_t(d)][p] = sim.held_faces.moved(d, x[size_t(d)][p], dt * vn[d]);
       }
       max_v2 = std::max(max_v2, v2);
       if constexpr (REMAP) {
@@ -283,7 +284,8 @@ class SinglePhase : public Scheme<D> {
       V[p] *= det_increment(l, dt);
       if (F[0]) update_deformation_gradient(F, l, dt, p);
       if constexpr (kMove)
-        for (int d = 0; d < D; ++d) x[size_t(d)][p] += dt * vn[d];
+        for (int d = 0; d < D; ++d)
+          x[size_t(d)][p] = sim.held_faces.moved(d, x[size_t(d)][p], dt * vn[d]);
       if constexpr (kFromRecord) {
         double v2 = 0;
         for (int d = 0; d < D; ++d) {
