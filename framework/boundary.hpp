@@ -4,9 +4,12 @@
 // and Simulation::constrain_update() once on the grid update of a step (all phases, with nodal
 // masses), which runs the conditions in passes whatever the order of the config: records
 // (before_constraints), the kinematic pass (constrain_grid_update, marking HeldComponents), the
-// Coulomb pass (coulomb_update) and the hydraulic conditions.
+// Coulomb pass (coulomb_update) and the hydraulic conditions. A mechanical condition that
+// holds the normal motion of its face says so (holds_face): no particle crosses that face
+// (HeldFaces, applied by the schemes wherever they move particles).
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -130,6 +133,11 @@ class Boundary {
   virtual void before_constraints(const GridUpdate&) {}
   /// The same before the conditions act on a single nodal vector of `phase`.
   virtual void before_constrain(const NodalVector& /*v*/, int /*phase*/) {}
+  /// The grid face (face_index) whose normal motion this condition holds for the particles, or
+  /// -1 (default: none; hydraulic conditions and faces that leave the solid's normal free).
+  /// The Simulation collects them at set-up (HeldFaces) and the schemes keep every particle on
+  /// or inside a held face, whatever the interpolated grid velocity near it.
+  virtual int holds_face() const { return -1; }
 };
 
 /// The nodes on one face of the grid ("x-", "x+", "y-", ...), for face-based plugins.
@@ -138,6 +146,50 @@ struct Face {
   bool upper = false;
 };
 Face parse_face(const std::string& name);
+/// The face's position in face_names(): 2 axis + upper ("x-" 0, "x+" 1, "y-" 2, ...).
+inline int face_index(const Face& f) {
+  return 2 * f.axis + (f.upper ? 1 : 0);
+}
+
+/// The faces that hold the particles, as bounds per axis: lower[d] is the grid's lower
+/// coordinate along d if some condition holds face 2 d (Boundary::holds_face), else -inf;
+/// upper[d] likewise. Schemes pass every particle move through moved(). A particle leaving
+/// through an open face is left alone, for Simulation::check_particles to report (exit 3).
+template <int D>
+struct HeldFaces {
+  std::array<double, D> lower, upper;
+  HeldFaces() {
+    lower.fill(-std::numeric_limits<double>::infinity());
+    upper.fill(std::numeric_limits<double>::infinity());
+  }
+  template <class Boundaries>
+  HeldFaces(const Grid<D>& grid, const Boundaries& boundaries) : HeldFaces() {
+    for (const auto& b : boundaries) {
+      const int f = b->holds_face();
+      if (f < 0 || f >= 2 * D) continue;
+      const int d = f / 2;
+      if (f % 2)
+        upper[size_t(d)] = grid.upper(d);
+      else
+        lower[size_t(d)] = grid.origin[size_t(d)];
+    }
+  }
+  /// Coordinate d of a particle at x after the move dx. A move that would reach or cross a held
+  /// face stops halfway between x and the face instead. Not on the face: there every shape
+  /// function weights the face nodes alone (the boundary half-cell is linear, S_1 = t = 0), so
+  /// the normal velocity would stay the face's zero and a slip or fixed face would keep the
+  /// particle for good (a water particle stopped on a slip lid was still on it 45 s later).
+  /// Halfway follows the approach to a held face that the grid gives when it does not
+  /// overshoot: the normal velocity t v_1 falls with the distance t h. Only the position
+  /// changes, never the velocity, so no momentum is added. Comparisons keep a NaN a NaN, for
+  /// Simulation::check_particles.
+  double moved(int d, double x, double dx) const {
+    const double to = x + dx, lo = lower[size_t(d)], hi = upper[size_t(d)];
+    if (to <= lo) return lo + 0.5 * (x - lo);
+    if (to >= hi) return hi - 0.5 * (hi - x);
+    return to;
+  }
+};
 template <int D>
 std::vector<size_t> face_nodes(const Grid<D>& grid, const Face& face);
 /// Report a face that does not exist in this dimension; returns false then.

@@ -1,7 +1,8 @@
 #pragma once
 // Scheme plugin interface: a scheme owns the order of one explicit step (which quantities go to
 // the grid, how the grid is integrated, what comes back), using the framework's building blocks
-// (stencils, partitioned block loops, boundary/load/damping hooks, material batches).
+// (stencils, partitioned block loops, boundary/load/damping hooks, material batches). Every
+// particle move goes through Simulation::held_faces.moved, so no particle crosses a held face.
 #include <limits>
 #include <string>
 #include <vector>

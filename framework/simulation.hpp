@@ -66,6 +66,9 @@ class Simulation {
   std::vector<std::unique_ptr<Sink<D>>> sinks;
   std::unique_ptr<Damping<D>> damping;
   std::unique_ptr<Reference<D>> reference;
+  /// The faces the boundary conditions hold (Boundary::holds_face), collected at set-up: schemes
+  /// pass every particle move through held_faces.moved.
+  HeldFaces<D> held_faces;
 
   Vec gravity{};
   double time = 0, dt = 0, end_time = 0, cfl = 0.5, fixed_dt = 0;

@@ -62,6 +62,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
       if (r.end > r.begin) materials[m]->initialize(s.particles, r.begin, r.end);
     }
   for (auto& b : boundaries) b->setup(*this, diag);
+  held_faces = HeldFaces<D>(grid, boundaries);
   model_checked = true;
   if (!particles_ok) return;  // loads and references select particles
   for (auto& l : loads) l->setup(*this, diag);

@@ -260,7 +260,7 @@ class SinglePhase : public Scheme<D> {
   }
 
   /// Grid-to-particle velocity update of one block (FLIP/PIC blend); REMAP and MOVE as in
-  /// update_velocities.
+  /// update_velocities (a move never crosses a held face: Simulation::held_faces).
   template <int NPP, bool REMAP, bool MOVE>
   void update_velocity(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
                        int thread) {
@@ -293,7 +293,7 @@ class SinglePhase : public Scheme<D> {
         double& vp = v[size_t(d)][p];
         vp = flip_pic(flip_, vp, dt, a[d], vn[d]);
         v2 += vp * vp;
-        if constexpr (MOVE) x[size_t(d)][p] += dt * vn[d];
+        if constexpr (MOVE) x[size_t(d)][p] = sim.held_faces.moved(d, x[size_t(d)][p], dt * vn[d]);
       }
       max_v2 = std::max(max_v2, v2);
       if constexpr (REMAP) {
@@ -349,7 +349,8 @@ class SinglePhase : public Scheme<D> {
       store_velocity_gradient<D>(l, L, p);
       update_volume_and_deformation<D>(l, dt, V[p], F, p);
       if constexpr (kMove)
-        for (int d = 0; d < D; ++d) x[size_t(d)][p] += dt * vn[d];
+        for (int d = 0; d < D; ++d)
+          x[size_t(d)][p] = sim.held_faces.moved(d, x[size_t(d)][p], dt * vn[d]);
       if constexpr (kFromRecord) {
         double v2 = 0;
         for (int d = 0; d < D; ++d) {

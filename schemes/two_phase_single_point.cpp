@@ -520,7 +520,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     double max_v2 = sc.max_v2;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      max_v2 = std::max(max_v2, velocity_update<false>(P, st, p, i, npp, dt, &move_[i * D]));
+      max_v2 = std::max(max_v2, velocity_update<false>(sim, P, st, p, i, npp, dt, &move_[i * D]));
       const double ms = P.col(P.mass)[i], mw = P.col(n_)[i] * rho_w_ * P.col(P.volume)[i];
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -550,11 +550,11 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   }
 
   /// Particle p (index i) of a block: FLIP/PIC update of v and w from the grid record and its
-  /// move dt v_grid with the solid grid velocity: done now with MOVE, else stored in `move`
-  /// (D values) for the gradient pass; returns |v|^2.
+  /// move dt v_grid with the solid grid velocity: done now with MOVE (kept inside the held
+  /// faces), else stored in `move` (D values) for the gradient pass; returns |v|^2.
   template <bool MOVE>
-  double velocity_update(Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
-                         double dt, double* move = nullptr) {
+  double velocity_update(const Simulation<D>& sim, Particles<D>& P, const StencilBlock<D>& st,
+                         int p, size_t i, int npp, double dt, double* move = nullptr) {
     double vn[D] = {}, wn[D] = {}, as[D] = {}, aw[D] = {};
     for (int k = 0; k < npp; ++k) {
       const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -574,7 +574,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       v = flip_pic(flip_, v, dt, as[d], vn[d]);
       w = flip_pic(flip_, w, dt, aw[d], wn[d]);
       if constexpr (MOVE)
-        P.col(P.position, d)[i] += dt * vn[d];
+        P.col(P.position, d)[i] = sim.held_faces.moved(d, P.col(P.position, d)[i], dt * vn[d]);
       else
         move[d] = dt * vn[d];
       v2 += v * v;
@@ -598,7 +598,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       // USL: the velocity update happens here; MUSL did it in the re-map pass.
       // (the stencil was evaluated at x^n above, so moving here does not change it).
       if constexpr (!REMAPPED)
-        max_v2 = std::max(max_v2, velocity_update<true>(P, st, p, i, npp, dt));
+        max_v2 = std::max(max_v2, velocity_update<true>(sim, P, st, p, i, npp, dt));
       double ls[D][D] = {}, lw[D][D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -609,9 +609,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         add_velocity_gradient<D>(ls, vs, st, size_t(k), p);
         add_velocity_gradient<D>(lw, vw, st, size_t(k), p);
       }
-      // MUSL: move with the updated solid grid velocity, after L on the start-of-step stencil.
+      // MUSL: move with the updated solid grid velocity, after L on the start-of-step stencil;
+      // no particle crosses a held face.
       if constexpr (REMAPPED)
-        for (int d = 0; d < D; ++d) P.col(P.position, d)[i] += move_[i * D + size_t(d)];
+        for (int d = 0; d < D; ++d)
+          P.col(P.position, d)[i] =
+              sim.held_faces.moved(d, P.col(P.position, d)[i], move_[i * D + size_t(d)]);
       double trs = 0, trw = 0;
       for (int d = 0; d < D; ++d) {
         trs += ls[d][d];

@@ -31,6 +31,8 @@ class Fixed : public Boundary<D> {
     for (size_t n : nodes_)
       for (int d = 0; d < D; ++d) held.hold(n, d);
   }
+  /// The particles move with the solid: `phase: water` leaves them free.
+  int holds_face() const override { return applies_to(0) ? face_index(face_) : -1; }
 
  private:
   Params params_;

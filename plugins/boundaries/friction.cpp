@@ -59,6 +59,9 @@ class Friction : public Boundary<D> {
       if (into_face(v.at(n, a))) v.at(n, a) = 0.0;
   }
 
+  /// Contact is unilateral: the particles may move away from the face, never through it.
+  int holds_face() const override { return face_index(face_); }
+
   /// The normal velocity of every phase on the face before any condition acts: it decides the
   /// contact and sets the budget mu |v_n| even where a slip or fixed face holds v_n as well.
   void before_constraints(const GridUpdate& u) override {

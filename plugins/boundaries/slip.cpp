@@ -1,6 +1,8 @@
 // Slip (roller) grid face: the normal velocity component is zero, tangential motion is free.
 // `directions` fixes other components instead (slip per direction). The held components are
 // marked (mark_held): a friction face meeting this one at an edge slides only in the others.
+#include <algorithm>
+
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 
@@ -47,6 +49,12 @@ class Slip : public Boundary<D> {
   void mark_held(HeldComponents& held) const override {
     for (size_t n : nodes_)
       for (int d : fixed_) held.hold(n, d);
+  }
+  /// Only if the solid's normal is among the fixed directions (`directions: [y]` on x- holds a
+  /// tangential component: the particles may leave through x-).
+  int holds_face() const override {
+    const bool normal = std::find(fixed_.begin(), fixed_.end(), face_.axis) != fixed_.end();
+    return normal && applies_to(0) ? face_index(face_) : -1;
   }
 
  private:
