@@ -26,9 +26,6 @@ class Sink {
   /// set's size and arrives zeroed or marked by other sinks).
   virtual void mark(const Simulation<D>&, const ParticleSet<D>& set,
                     std::vector<uint8_t>& remove) const = 0;
-  /// Whether it removes particles that leave the grid through a face no mechanical condition
-  /// holds (so that they are not an unstable run).
-  virtual bool removes_leaving_particles() const { return false; }
   /// Whether it would remove particles somewhere in the box [lower, upper] (a source's region).
   virtual bool overlaps(const std::array<double, D>& lower,
                         const std::array<double, D>& upper) const = 0;

@@ -264,7 +264,6 @@ class Cpdi : public ShapeFunction<D> {
 
   void update_domains(Simulation<D>& sim, Particles<D>& P, std::string& failure,
                       double& largest_extent) {
-    const auto& g = sim.grid;
     double max_extent = largest_extent;
     const size_t n = P.size();
     const double* Fc[D * D];

@@ -164,6 +164,35 @@ TEST_CASE("a plane sink keeps a water level, a source window stops the inflow", 
   CHECK(std::fabs(s["mass"]["balance"].get<double>()) <= 1e-9 * created);
 }
 
+TEST_CASE("open_faces removes what leaves through the open end, without it that is exit 3",
+          "[sources]") {
+  // The channel's x+ face is open (no condition holds it): the water leaves the grid there.
+  TempDir with("channel_open"), without("channel_open_none");
+  auto r =
+      run_text(with.path, channel("", "  - {type: open_faces}\n"), "--set output.history_every=1");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  std::ifstream js(with.path / "out/summary.json");
+  const auto s = nlohmann::json::parse(js);
+  const auto h = read_csv_columns(with.path / "out/history.csv");
+  const double rate = slope(h.at("time"), h.at("mass_removed"), 1.2, 2.0);
+  std::printf(
+      "open_faces: removed %zu particles, outflow rate %.5g kg/s/m (rho v A = %.5g, %+.3f "
+      "%%, tolerance 1 %%), balance %.3g\n",
+      s["particles_removed"].get<size_t>(), rate, kRho * kV * kH,
+      100 * (rate / (kRho * kV * kH) - 1), s["mass"]["balance"].get<double>());
+  CHECK(s["particles_removed"].get<size_t>() > 1000);
+  CHECK(std::fabs(rate / (kRho * kV * kH) - 1) < 0.01);
+  CHECK(std::fabs(s["mass"]["balance"].get<double>()) <= 1e-9 * s["mass"]["created"].get<double>());
+  // Without a sink the first particle through the open face stops the run.
+  std::string none = channel();
+  none = none.substr(0, none.find("sinks:")) + none.substr(none.find("time:"));
+  auto r2 = run_text(without.path, none);
+  std::printf("without a sink: exit %d: %s", r2.exit_code, r2.output.c_str());
+  CHECK(r2.exit_code == 3);
+  CHECK(r2.output.find("left the grid") != std::string::npos);
+}
+
 TEST_CASE("sources and sinks: located errors for bad input, exit 2, nothing written",
           "[sources][bad_config]") {
   struct Case {
