@@ -228,7 +228,7 @@ class SinglePhase : public Scheme<D> {
                                  sim.grid.num_nodes, S});
     const double tol = sim.mass_tolerance;
     double* g = node_.data();
-    for_each_node(sim.grid.num_nodes, sim.threads, [&](size_t i) {
+    for_each_node(sim.grid.num_nodes, sim.threads, [=](size_t i) {
       double* r = g + i * S;
       if (r[kMass] > tol) {
         const double inv = 1.0 / r[kMass];
@@ -250,10 +250,12 @@ class SinglePhase : public Scheme<D> {
   /// Velocity from momentum in vel_ (MUSL re-map, USF), constrained.
   void momentum_to_velocity(Simulation<D>& sim, const double* momentum, int stride, int offset) {
     const double tol = sim.mass_tolerance;
-    for_each_node(sim.grid.num_nodes, sim.threads, [&](size_t i) {
-      const double m = node_[i * S + kMass];
+    const double* node = node_.data();
+    double* vel = vel_.data();
+    for_each_node(sim.grid.num_nodes, sim.threads, [=](size_t i) {
+      const double m = node[i * S + kMass];
       for (int d = 0; d < D; ++d)
-        vel_[i * D + size_t(d)] =
+        vel[i * D + size_t(d)] =
             m > tol ? momentum[i * size_t(stride) + size_t(offset + d)] / m : 0.0;
     });
     sim.constrain(vel_vector());
@@ -276,6 +278,9 @@ class SinglePhase : public Scheme<D> {
       x[size_t(d)] = P.col(P.position, d) + b;
     }
     const double* g = node_.data();
+    // Locals, not members: the stores through v and x could alias them and force reloads.
+    const double flip = flip_;
+    const HeldFaces<D> walls = sim.held_faces;
     double max_v2 = sc.max_v2;
     for (int p = 0; p < count; ++p) {
       double a[D] = {}, vn[D] = {};
@@ -291,9 +296,9 @@ class SinglePhase : public Scheme<D> {
       double v2 = 0;
       for (int d = 0; d < D; ++d) {
         double& vp = v[size_t(d)][p];
-        vp = flip_pic(flip_, vp, dt, a[d], vn[d]);
+        vp = flip_pic(flip, vp, dt, a[d], vn[d]);
         v2 += vp * vp;
-        if constexpr (MOVE) x[size_t(d)][p] = sim.held_faces.moved(d, x[size_t(d)][p], dt * vn[d]);
+        if constexpr (MOVE) x[size_t(d)][p] = walls.moved(d, x[size_t(d)][p], dt * vn[d]);
       }
       max_v2 = std::max(max_v2, v2);
       if constexpr (REMAP) {
@@ -332,6 +337,8 @@ class SinglePhase : public Scheme<D> {
     // Source of the velocity field whose gradient is taken.
     const double* vel = kFromRecord ? node_.data() + kMomentum : vel_.data();
     const size_t vstride = kFromRecord ? S : D;
+    const double flip = flip_;
+    const HeldFaces<D> walls = sim.held_faces;
     double max_v2 = sc.max_v2;
     for (int p = 0; p < count; ++p) {
       double l[D][D] = {}, vn[D] = {}, a[D] = {};
@@ -349,13 +356,12 @@ class SinglePhase : public Scheme<D> {
       store_velocity_gradient<D>(l, L, p);
       update_volume_and_deformation<D>(l, dt, V[p], F, p);
       if constexpr (kMove)
-        for (int d = 0; d < D; ++d)
-          x[size_t(d)][p] = sim.held_faces.moved(d, x[size_t(d)][p], dt * vn[d]);
+        for (int d = 0; d < D; ++d) x[size_t(d)][p] = walls.moved(d, x[size_t(d)][p], dt * vn[d]);
       if constexpr (kFromRecord) {
         double v2 = 0;
         for (int d = 0; d < D; ++d) {
           double& vp = v[size_t(d)][p];
-          vp = flip_pic(flip_, vp, dt, a[d], vn[d]);
+          vp = flip_pic(flip, vp, dt, a[d], vn[d]);
           v2 += vp * vp;
         }
         max_v2 = std::max(max_v2, v2);
