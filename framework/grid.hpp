@@ -58,6 +58,17 @@ struct Grid {
     for (int d = 0; d < D; ++d) c += size_t(cell_of(x[d], d)) * size_t(cell_stride[d]);
     return c;
   }
+  std::array<double, D> upper_corner() const {
+    std::array<double, D> u{};
+    for (int d = 0; d < D; ++d) u[d] = upper(d);
+    return u;
+  }
+  /// Whether the box [lo, hi] lies inside the grid (to 1e-12 m: corners written on a face).
+  bool holds_box(const std::array<double, D>& lo, const std::array<double, D>& hi) const {
+    for (int d = 0; d < D; ++d)
+      if (!(lo[d] >= origin[d] - 1e-12 && hi[d] <= upper(d) + 1e-12)) return false;
+    return true;
+  }
   bool inside(const std::array<double, D>& x) const {
     for (int d = 0; d < D; ++d)
       if (!(x[d] >= origin[d] && x[d] <= upper(d))) return false;

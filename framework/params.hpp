@@ -3,6 +3,7 @@
 // One Schema describes what a plugin (or a config section) accepts: type, unit, default or
 // required, range or choices and a doc string. The same Schema validates YAML and generates
 // `loam plugins` documentation, so the docs cannot drift from the checks (OpenFOAM/MOOSE habit).
+#include <array>
 #include <functional>
 #include <limits>
 #include <map>
@@ -217,5 +218,19 @@ Location location_of(const YAML::Node& node, const std::string& path, const Vali
 
 /// Format a number the way users wrote it (shortest round-trip-ish form).
 std::string format_number(double v);
+
+/// A box for messages: "[x0, y0] to [x1, y1]".
+template <size_t N>
+std::string format_box(const std::array<double, N>& lo, const std::array<double, N>& hi) {
+  std::string s = "[";
+  for (size_t d = 0; d < N; ++d) s += (d ? ", " : "") + format_number(lo[d]);
+  s += "] to [";
+  for (size_t d = 0; d < N; ++d) s += (d ? ", " : "") + format_number(hi[d]);
+  return s + "]";
+}
+
+/// The schema check of a box given by `min` and `max`: max > min along every axis (except
+/// `skip_axis`, e.g. the normal of a face patch).
+void check_box_corners(const Params& p, Diagnostics& d, int skip_axis = -1);
 
 }  // namespace loam

@@ -33,6 +33,13 @@ class ParticleSet {
   bool resized = false;     // particles were added or removed since the last sort
 
   size_t size() const { return particles.size(); }
+  /// Sum of the `mass` field (the whole mass in one-phase schemes, the solid's in two-phase).
+  double mass() const {
+    const double* m = particles.col(particles.mass);
+    double total = 0;
+    for (size_t i = 0; i < size(); ++i) total += m[i];
+    return total;
+  }
 
   /// Particle index of an id of this set (valid until the next sort); npos if not in the set.
   static constexpr size_t npos = std::numeric_limits<size_t>::max();

@@ -9,7 +9,6 @@ void Partition<D>::sort(Particles<D>& p, const Grid<D>& g, int num_materials, in
                         int num_threads) {
   threads = num_threads;
   const size_t n = p.size();
-  sorted_count = n;
   const size_t ncells = g.num_cells;
   const size_t nkeys = size_t(num_materials) * ncells;
   keys_.resize(n);

@@ -40,10 +40,6 @@ class Partition {
   std::vector<Slab> slabs;
   std::vector<IndexRange> material_ranges;
   int threads = 1;
-  size_t sorted_count = 0;  // particles at the last sort
-
-  /// Whether the slabs cover exactly n particles (false after a source added some).
-  bool covers(size_t n) const { return sorted_count == n; }
 
   /// Sort particles by (material, cell) and rebuild slabs. `reach` = rows_below + rows_above
   /// of the shape function.

@@ -66,15 +66,13 @@ nlohmann::json Run<D>::base_summary() const {
     std::vector<std::string> bodies;
     for (int b : set.bodies)
       bodies.push_back(sim_->bodies.size() > size_t(b) ? sim_->bodies[size_t(b)].name : "");
-    double mass = 0, kinetic = 0;  // the particles' own (a scheme's second phase not included)
+    double kinetic = 0;  // the particles' own (a scheme's second phase not included)
     const Particles<D>& P = set.particles;
-    for (size_t i = 0; i < P.size(); ++i) {
-      const double m = P.col(P.mass)[i];
-      mass += m;
-      for (int d = 0; d < D; ++d) kinetic += 0.5 * m * std::pow(P.col(P.velocity, d)[i], 2);
-    }
+    for (size_t i = 0; i < P.size(); ++i)
+      for (int d = 0; d < D; ++d)
+        kinetic += 0.5 * P.col(P.mass)[i] * std::pow(P.col(P.velocity, d)[i], 2);
     sets[set.name] = {{"particles", set.size()},
-                      {"mass", mass},
+                      {"mass", set.mass()},
                       {"kinetic_energy", kinetic},
                       {"bodies", bodies},
                       {"bytes_per_particle", set.particles.bytes_per_particle()}};

@@ -15,6 +15,15 @@ std::string format_number(double v) {
   return s.str();
 }
 
+void check_box_corners(const Params& p, Diagnostics& d, int skip_axis) {
+  const auto &lo = p.vec("min"), &hi = p.vec("max");
+  for (size_t i = 0; i < lo.size() && i < hi.size(); ++i)
+    if (int(i) != skip_axis && hi[i] <= lo[i]) {
+      d.error(p.where("max"), p.path("max"), "max must exceed min along every axis");
+      return;
+    }
+}
+
 bool ParamSpec::has_range() const {
   return std::isfinite(lo) || std::isfinite(hi);
 }

@@ -105,10 +105,7 @@ void Simulation<D>::apply_sinks() {
 template <int D>
 double Simulation<D>::total_mass() const {
   double m = 0;
-  for (const auto& set : sets) {
-    const double* ms = set.particles.col(set.particles.mass);
-    for (size_t i = 0; i < set.size(); ++i) m += ms[i];
-  }
+  for (const auto& set : sets) m += set.mass();
   return m;
 }
 
@@ -242,7 +239,8 @@ bool Simulation<D>::selection(const std::string& name, const ParticleSet<D>& set
 }
 
 template <int D>
-int Simulation<D>::body_param(const Params& p, const std::string& key, Diagnostics& diag) const {
+int Simulation<D>::body_param(const Params& p, const std::string& key, Diagnostics& diag,
+                              bool need_particles) const {
   if (!p.has(key)) {  // the first body with particles at t = 0
     for (size_t b = 0; b < bodies.size(); ++b)
       if (bodies[b].count > 0) return int(b);
@@ -254,7 +252,7 @@ int Simulation<D>::body_param(const Params& p, const std::string& key, Diagnosti
     for (const auto& bd : bodies) names.push_back(bd.name);
     diag.error(p.where(key), p.path(key),
                "unknown body '" + p.text(key) + "'; bodies are: " + join(names, ", "));
-  } else if (bodies[size_t(b)].count == 0) {
+  } else if (need_particles && bodies[size_t(b)].count == 0) {
     diag.error(p.where(key), p.path(key),
                "body '" + p.text(key) + "' has no particles at t = 0 (no generator)");
     return -1;

@@ -231,7 +231,10 @@ class Simulation {
   int body_index(const std::string& name) const;
   /// The body a plugin names with `key` (the first body when the key is absent), or -1 after a
   /// located "unknown body" error listing the bodies.
-  int body_param(const Params& p, const std::string& key, Diagnostics& diag) const;
+  /// With need_particles (loads, references), a body that starts empty (no generator) is an
+  /// error too; a source names such a body.
+  int body_param(const Params& p, const std::string& key, Diagnostics& diag,
+                 bool need_particles = true) const;
 
   /// First particle whose position, velocity or stress is not finite, or that left the grid:
   /// returns false and fills a description.

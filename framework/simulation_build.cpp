@@ -6,7 +6,6 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
-#include <sstream>
 
 #include "registry.hpp"
 
@@ -182,23 +181,11 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
       diag.error(bp.where("generator"), bp.path("generator"), problem);
       continue;
     }
-    Vec lo = gen->lower(), hi = gen->upper();
-    bool inside = true;
-    for (int d = 0; d < D; ++d)
-      inside = inside && lo[size_t(d)] >= grid.origin[size_t(d)] - 1e-12 &&
-               hi[size_t(d)] <= grid.upper(d) + 1e-12;
-    if (!inside) {
-      std::ostringstream s;
-      s << "particles outside the grid: the body spans [";
-      for (int d = 0; d < D; ++d) s << (d ? ", " : "") << format_number(lo[size_t(d)]);
-      s << "] to [";
-      for (int d = 0; d < D; ++d) s << (d ? ", " : "") << format_number(hi[size_t(d)]);
-      s << "] but the grid spans [";
-      for (int d = 0; d < D; ++d) s << (d ? ", " : "") << format_number(grid.origin[size_t(d)]);
-      s << "] to [";
-      for (int d = 0; d < D; ++d) s << (d ? ", " : "") << format_number(grid.upper(d));
-      s << "]";
-      diag.error(bp.where("generator"), bp.path("generator"), s.str());
+    const Vec lo = gen->lower(), hi = gen->upper();
+    if (!grid.holds_box(lo, hi)) {
+      diag.error(bp.where("generator"), bp.path("generator"),
+                 "particles outside the grid: the body spans " + format_box(lo, hi) +
+                     " but the grid spans " + format_box(grid.origin, grid.upper_corner()));
       continue;
     }
     const int ppc = int(bp.integer("particles_per_cell"));

@@ -88,6 +88,21 @@ struct TempDir {
   ~TempDir() { std::filesystem::remove_all(path); }
 };
 
+/// Write `yaml` to dir/run.yaml and run it (quiet) into dir/out.
+inline CliResult run_yaml(const std::filesystem::path& dir, const std::string& yaml,
+                          const std::string& args = "") {
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "run.yaml") << yaml;
+  return run_loam("run " + (dir / "run.yaml").string() + " --quiet --out " +
+                  (dir / "out").string() + " " + args);
+}
+
+/// The whole text of a file.
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 /// Run a config from configs/ (with extra arguments) into `out` and return its summary.json.
 inline nlohmann::json run_scene(const std::string& config, const std::filesystem::path& out,
                                 const std::string& extra = "") {

@@ -1,5 +1,5 @@
-// The viscous absorbing boundary (plugins/boundaries/absorbing.cpp, Lysmer & Kuhlemeyer 1969): its nodal
-// update against hand values (tributary areas, implicit dashpot, the two-phase impermeable
+// The viscous absorbing boundary (plugins/boundaries/absorbing.cpp, Lysmer & Kuhlemeyer 1969): its
+// nodal update against hand values (tributary areas, implicit dashpot, the two-phase impermeable
 // form), the reflection of a 1D/2D elastic pulse (single_phase) and of the undrained wave in a
 // saturated column (two_phase_single_point) against the same scenes with a fixed face, and its
 // located input errors.
@@ -92,10 +92,10 @@ void check_nodal_update(const std::string& yaml, int axis, const std::vector<dou
 
 TEST_CASE("absorbing: implicit dashpots with tributary face areas, hand values",
           "[boundary][unit]") {
-  // Reference: the plugin's equations (plugins/boundaries/absorbing.cpp header): v = m v*/(m + dt rho c A)
-  // per component (c_p normal, c_s tangential), a += (v - v*)/dt; two phases: common normal
-  // velocity (m_s v_s* + m_w v_w*)/(m_s + m_w + dt rho c_p A), water tangential untouched. A:
-  // 1 in 1D; h or h/2 (grid edge) in 2D; h1 h2, /2 on an edge, /4 at a corner in 3D. Nodes off
+  // Reference: the plugin's equations (plugins/boundaries/absorbing.cpp header): v = m v*/(m + dt
+  // rho c A) per component (c_p normal, c_s tangential), a += (v - v*)/dt; two phases: common
+  // normal velocity (m_s v_s* + m_w v_w*)/(m_s + m_w + dt rho c_p A), water tangential untouched.
+  // A: 1 in 1D; h or h/2 (grid edge) in 2D; h1 h2, /2 on an edge, /4 at a corner in 3D. Nodes off
   // the face are not touched. Tolerance 1e-12 (rounding of O(1) values).
   auto scene = [](const std::string& grid, const std::string& lo, const std::string& hi,
                   const std::string& face, bool shear) {

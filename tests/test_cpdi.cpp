@@ -284,7 +284,8 @@ TEST_CASE("cpdi: a grown reach re-sorts the slab colouring when it is no longer 
       "slabs after\n",
       slabs_before, safe_without_resort ? "yes" : "no", sim->sets[0].partition.slabs.size());
   CHECK_FALSE(safe_without_resort);  // the test is meaningful
-  CHECK(sim->sets[0].partition.verify(P, sim->grid, sim->shape->rows_below(), sim->shape->rows_above()));
+  CHECK(sim->sets[0].partition.verify(P, sim->grid, sim->shape->rows_below(),
+                                      sim->shape->rows_above()));
   // And the step itself runs (scatter, gather, F update) with the stretched domains.
   CHECK_NOTHROW(advance(*sim, 2));
 }

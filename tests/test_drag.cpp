@@ -214,7 +214,8 @@ TEST_CASE("ergun: a batch equals point-by-point evaluation", "[drag][unit]") {
 }
 
 TEST_CASE("darcy: bad parameters give the located error", "[drag][unit]") {
-  // Reference: the standard FILE:LINE:COL: error: path: message (docs/architecture.md "Errors"), one line each.
+  // Reference: the standard FILE:LINE:COL: error: path: message (docs/architecture.md "Errors"),
+  // one line each.
   struct Case {
     std::string yaml, error;
   };
@@ -245,7 +246,8 @@ TEST_CASE("darcy: bad parameters give the located error", "[drag][unit]") {
 }
 
 TEST_CASE("ergun: bad parameters give the located error", "[drag][unit]") {
-  // Reference: the standard FILE:LINE:COL: error: path: message (docs/architecture.md "Errors"), one line each.
+  // Reference: the standard FILE:LINE:COL: error: path: message (docs/architecture.md "Errors"),
+  // one line each.
   struct Case {
     std::string yaml, error;
   };

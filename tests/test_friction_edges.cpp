@@ -1,9 +1,10 @@
-// Coulomb friction where a friction face meets other faces (plugins/boundaries/friction.cpp, the passes of
-// Simulation::constrain_update): every normal/kinematic constraint first, then each friction
-// face's impulse mu |v_n| (v_n before any constraint) in the tangential components no condition
-// holds (Bardenhagen, Brackbill & Sulsky 2000). The result must not depend on the order of the
-// `boundaries` list: node-level hand values, every permutation of a mixed corner, the two-phase
-// update and the MUSL re-mapped path, and a 3D block sliding along a wall on a frictional base.
+// Coulomb friction where a friction face meets other faces (plugins/boundaries/friction.cpp, the
+// passes of Simulation::constrain_update): every normal/kinematic constraint first, then each
+// friction face's impulse mu |v_n| (v_n before any constraint) in the tangential components no
+// condition holds (Bardenhagen, Brackbill & Sulsky 2000). The result must not depend on the order
+// of the `boundaries` list: node-level hand values, every permutation of a mixed corner, the
+// two-phase update and the MUSL re-mapped path, and a 3D block sliding along a wall on a frictional
+// base.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -86,8 +87,8 @@ double max_difference(const Nodes& a, const Nodes& b) {
 
 TEST_CASE("friction edges: a friction base and a slip wall give the Coulomb answer in both orders",
           "[boundary][unit]") {
-  // Reference (hand values, plugins/boundaries/friction.cpp): edge node of the friction base y- (mu = 1)
-  // and the slip wall x-, v* = (-1, -0.5, 1), dt = 0.01, a* = (5, 6, 7). The wall holds v_x,
+  // Reference (hand values, plugins/boundaries/friction.cpp): edge node of the friction base y- (mu
+  // = 1) and the slip wall x-, v* = (-1, -0.5, 1), dt = 0.01, a* = (5, 6, 7). The wall holds v_x,
   // the base v_y (into it: budget mu |v_n| = 0.5); the free tangential speed |v_z| = 1 drops by
   // 0.5: v = (0, 0, 0.5). The wall zeroes a_x; friction adds (v - v*)/dt: a_y = 6 + 50,
   // a_z = 7 - 50. A base node off the wall slides in (x, z): |v_t| = sqrt 2 -> sqrt 2 - 0.5.

@@ -1,8 +1,8 @@
 // The granular-collapse scene (configs/granular_collapse_2d.yaml) and the friction boundary it
 // uses. Reference: the empirical scaling of quasi-2D laboratory collapses of Lube et al. (2005)
-// (plugins/references/granular_collapse.cpp), at a = H0/L0 = 2: (L_f - L0)/L0 = 2.483, H_f/L0 = 1.320.
-// An experimental trend, so the full tier (the scene as shipped, cell 0.01 m) holds a 15 % band.
-// Resolution study (this scene, --set grid.cell_size=h, 2 particles per cell per axis;
+// (plugins/references/granular_collapse.cpp), at a = H0/L0 = 2: (L_f - L0)/L0 = 2.483, H_f/L0
+// = 1.320. An experimental trend, so the full tier (the scene as shipped, cell 0.01 m) holds a 15 %
+// band. Resolution study (this scene, --set grid.cell_size=h, 2 particles per cell per axis;
 // deterministic: 1 and 2 threads give identical results):
 //   h (m)     0.04    0.03    0.025   0.02    0.015   0.01    0.0075  0.005
 //   run-out   -31.2%  -24.9%  -18.4%  -12.2%  -3.7%   +6.1%   +12.1%  +21.6%  against Lube 2005
@@ -80,9 +80,9 @@ TEST_CASE("granular collapse 2D: deposit within 15 % of Lube et al. (2005)",
 
 TEST_CASE("friction boundary: a block sliding on the base decelerates at mu g",
           "[boundary][unit]") {
-  // Coulomb friction (plugins/boundaries/friction.cpp): an elastic block (one cell high) sliding at v0 on
-  // a base with friction mu. References:
-  // (1) Coulomb's law in impulse form: while every loaded base node slides, the tangential
+  // Coulomb friction (plugins/boundaries/friction.cpp): an elastic block (one cell high) sliding at
+  // v0 on a base with friction mu. References: (1) Coulomb's law in impulse form: while every
+  // loaded base node slides, the tangential
   //     impulse is mu times the normal impulse, and the normal impulse over [0, t] is the
   //     weight's, m g t, plus the change of the block's vertical momentum m vy(t) (vy(0) = 0).
   //     Hence, for the mass-weighted mean velocities, exactly

@@ -1,8 +1,8 @@
-// Hydraulic face conditions of the two-phase scheme (plugins/boundaries/drained.cpp, impermeable.cpp,
-// prescribed_pore_pressure.cpp; framework/hydraulic_face.hpp) on the seed-001 Terzaghi column
-// (configs/seed001_terzaghi.yaml: 1 m, c_v = 1.0194 m^2/s, p0 = 10 kPa, free drained top, fixed
-// base), and the `phase` option of fixed/slip. References: Terzaghi's series (docs/verification.md
-// C, plugins/references/terzaghi.hpp) and equilibrium.
+// Hydraulic face conditions of the two-phase scheme (plugins/boundaries/drained.cpp,
+// impermeable.cpp, prescribed_pore_pressure.cpp; framework/hydraulic_face.hpp) on the seed-001
+// Terzaghi column (configs/seed001_terzaghi.yaml: 1 m, c_v = 1.0194 m^2/s, p0 = 10 kPa, free
+// drained top, fixed base), and the `phase` option of fixed/slip. References: Terzaghi's series
+// (docs/verification.md C, plugins/references/terzaghi.hpp) and equilibrium.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>

@@ -77,21 +77,9 @@ Deposit deposit(const std::map<int, std::array<double, 2>>& x) {
   return d;
 }
 
-CliResult run_text(const TempDir& dir, const std::string& yaml, const std::string& args) {
-  fs::create_directories(dir.path);
-  std::ofstream(dir.path / "run.yaml") << yaml;
-  return run_loam("run " + (dir.path / "run.yaml").string() + " --quiet --out " +
-                  (dir.path / "out").string() + " " + args);
-}
-
 nlohmann::json summary(const TempDir& dir) {
   std::ifstream in(dir.path / "out" / "summary.json");
   return nlohmann::json::parse(in);
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 }  // namespace
@@ -109,8 +97,8 @@ TEST_CASE("granular collapse split over two sets: same run-out and height as one
     const std::string args =
         "--threads " + std::to_string(threads) +
         (threads == 2 ? " --set time.end=0.25 --set output.every_time=0.125" : "");
-    REQUIRE(run_text(one, split_collapse(false), args).exit_code == 0);
-    REQUIRE(run_text(two, split_collapse(true), args).exit_code == 0);
+    REQUIRE(run_yaml(one.path, split_collapse(false), args).exit_code == 0);
+    REQUIRE(run_yaml(two.path, split_collapse(true), args).exit_code == 0);
     const auto a = positions_by_id({one.path / "out/particles_000002.h5"});
     const auto b =
         positions_by_id({two.path / "out/left_000002.h5", two.path / "out/right_000002.h5"});
@@ -146,8 +134,8 @@ TEST_CASE("granular collapse split over two sets: same run-out and height as one
 TEST_CASE("each set has its own ParaView frames and stores only its bodies' fields", "[sets]") {
   // Right half linear elastic: plastic_strain_eq (Mohr-Coulomb state) exists only in `left`.
   TempDir dir("sets_output");
-  auto r = run_text(
-      dir, split_collapse(true, "{type: linear_elastic, E: 5.0e6, nu: 0.3, density: 1800}"),
+  auto r = run_yaml(
+      dir.path, split_collapse(true, "{type: linear_elastic, E: 5.0e6, nu: 0.3, density: 1800}"),
       "--threads 1 --set time.end=0.1 --set output.every_time=0.05");
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
@@ -186,7 +174,7 @@ TEST_CASE("a probe follows a particle of the set it names", "[sets]") {
       "probes:\n"
       "  - {name: r, set: right, particle_near: [0.05, 0.2], fields: [position]}\n"
       "  - {name: l, particle_near: [0.05, 0.2], fields: [position]}\n";
-  auto r = run_text(dir, yaml, "--threads 1 --set time.end=0.01");
+  auto r = run_yaml(dir.path, yaml, "--threads 1 --set time.end=0.01");
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
   const auto pr = read_csv_columns(dir.path / "out/probe_r.csv");
@@ -238,7 +226,7 @@ TEST_CASE("bad particle-set input: located errors listing the valid sets, exit 2
   };
   for (const auto& c : cases) {
     TempDir dir("sets_bad");
-    auto r = run_text(dir, c.yaml, "--threads 1");
+    auto r = run_yaml(dir.path, c.yaml, "--threads 1");
     std::printf("%s: exit %d: %s", c.what.c_str(), r.exit_code, r.output.c_str());
     CHECK(r.exit_code == 2);
     CHECK(r.output.find(c.expect) != std::string::npos);

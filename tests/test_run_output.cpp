@@ -7,14 +7,8 @@
 #include "cli.hpp"
 
 using loam_test::run_loam;
+using loam_test::slurp;
 using loam_test::TempDir;
-
-static std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 TEST_CASE("a run writes XDMF frames, probes, history and a complete summary", "[output]") {
   TempDir dir("output");

@@ -1,5 +1,5 @@
-// The settlement reference (plugins/references/settlement.cpp) on hand-made states: particle volumes,
-// stresses and pore pressures set directly, metrics against values computed by hand. The
+// The settlement reference (plugins/references/settlement.cpp) on hand-made states: particle
+// volumes, stresses and pore pressures set directly, metrics against values computed by hand. The
 // seed 001 MCC regression (tests/test_seed001_mcc.cpp) uses it through the command line.
 #include <yaml-cpp/yaml.h>
 

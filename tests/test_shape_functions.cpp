@@ -40,7 +40,8 @@ using loam_test::NodeValues;
 template <int D>
 NodeValues<D> evaluate_at(loam::Simulation<D>& sim, const std::array<double, D>& x,
                           size_t particle = 0) {
-  for (int d = 0; d < D; ++d) sim.sets[0].particles.col(sim.sets[0].particles.position, d)[particle] = x[size_t(d)];
+  for (int d = 0; d < D; ++d)
+    sim.sets[0].particles.col(sim.sets[0].particles.position, d)[particle] = x[size_t(d)];
   return loam_test::node_values(sim, particle);
 }
 

@@ -1,9 +1,10 @@
-// Terzaghi one-way consolidation (plugins/references/terzaghi.hpp series, plugins/references/terzaghi.cpp reference;
-// docs/verification.md C). The series are checked against classic tables (U(T) and T(U)), a sum
-// written out here, closed forms, their own limits and boundary conditions, each other, and the
-// two-way layer that tests/test_hydraulic_boundaries.cpp maps onto them; the reference plugin is
-// checked by filling the pore_pressure field with known values (no two-phase scheme exists yet) and
-// through the CLI for its located errors.
+// Terzaghi one-way consolidation (plugins/references/terzaghi.hpp series,
+// plugins/references/terzaghi.cpp reference; docs/verification.md C). The series are checked
+// against classic tables (U(T) and T(U)), a sum written out here, closed forms, their own limits
+// and boundary conditions, each other, and the two-way layer that
+// tests/test_hydraulic_boundaries.cpp maps onto them; the reference plugin is checked by filling
+// the pore_pressure field with known values (no two-phase scheme exists yet) and through the CLI
+// for its located errors.
 #include <yaml-cpp/yaml.h>
 
 #include <catch2/catch.hpp>
@@ -57,8 +58,8 @@ TEST_CASE("terzaghi: small time factors follow U = 2 sqrt(T/pi)", "[reference][u
 }
 
 TEST_CASE("terzaghi: the Fourier and image series agree", "[reference][unit]") {
-  // Reference: two independent forms of the same solution (plugins/references/terzaghi.hpp). Where both
-  // converge (1e-4 <= T <= 2) they must agree. Tolerance: 1e-13 absolute on p/p0 and U.
+  // Reference: two independent forms of the same solution (plugins/references/terzaghi.hpp). Where
+  // both converge (1e-4 <= T <= 2) they must agree. Tolerance: 1e-13 absolute on p/p0 and U.
   double worst_p = 0, worst_u = 0;
   int most_f = 0, most_i = 0;
   for (double T : {1e-4, 1e-3, 0.005, 0.01, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0}) {

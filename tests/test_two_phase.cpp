@@ -31,8 +31,7 @@ void check_terzaghi(const std::string& config, const std::string& extra = "") {
               s["wall_seconds"].get<double>());
   // Scalar particle fields are scalars in the ParaView index, also in 1D (where a scalar and a
   // spatial vector both have one component).
-  std::ifstream in(dir.path / "particles.xdmf");
-  const std::string xdmf((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string xdmf = loam_test::slurp(dir.path / "particles.xdmf");
   CHECK(xdmf.find("Name=\"pore_pressure\" AttributeType=\"Scalar\"") != std::string::npos);
   CHECK(xdmf.find("Name=\"velocity\" AttributeType=\"Vector\"") != std::string::npos);
 }

@@ -13,11 +13,7 @@ class Box : public Generator<D> {
     Schema s;
     s.vector("min", "m", "lower corner").required();
     s.vector("max", "m", "upper corner").required();
-    s.check([](const Params& p, Diagnostics& d) {
-      for (int i = 0; i < int(p.vec("min").size()); ++i)
-        if (p.vec("max")[size_t(i)] <= p.vec("min")[size_t(i)])
-          d.error(p.where("max"), p.path("max"), "max must exceed min along every axis");
-    });
+    s.check([](const Params& p, Diagnostics& d) { check_box_corners(p, d); });
     return s;
   }
   explicit Box(const Params& p) {

@@ -15,11 +15,7 @@ class Region : public SinkOnSets<D> {
     s.vector("min", "m", "lower corner of the box").required();
     s.vector("max", "m", "upper corner of the box").required();
     SinkOnSets<D>::add_set_param(s);
-    s.check([](const Params& p, Diagnostics& d) {
-      for (size_t i = 0; i < p.vec("min").size(); ++i)
-        if (p.vec("max")[i] <= p.vec("min")[i])
-          d.error(p.where("max"), p.path("max"), "max must exceed min along every axis");
-    });
+    s.check([](const Params& p, Diagnostics& d) { check_box_corners(p, d); });
     return s;
   }
   explicit Region(const Params& p) : SinkOnSets<D>(p) {

@@ -13,7 +13,6 @@
 // the inlet is a velocity inlet whatever the pressure downstream.
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "framework/boundary.hpp"
 #include "framework/registry.hpp"
@@ -50,11 +49,7 @@ class Inflow : public Source<D> {
       if (!(v2 > 0)) d.error(p.where("velocity"), p.path("velocity"), "zero velocity: no inflow");
       if (p.has("end") && p.real("end") <= p.real("start"))
         d.error(p.where("end"), p.path("end"), "end must be after start");
-      const auto &lo = p.vec("min"), &hi = p.vec("max");
-      const Face f = p.has("face") ? parse_face(p.text("face")) : Face{-1, false};
-      for (size_t i = 0; i < lo.size(); ++i)
-        if (int(i) != f.axis && hi[i] <= lo[i])
-          d.error(p.where("max"), p.path("max"), "max must exceed min along every axis");
+      check_box_corners(p, d, p.has("face") ? parse_face(p.text("face")).axis : -1);
     });
     return s;
   }
@@ -71,26 +66,16 @@ class Inflow : public Source<D> {
   }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    body_ = sim.body_index(params_.text("body"));
-    if (body_ < 0) {
-      std::vector<std::string> names;
-      for (const auto& b : sim.bodies) names.push_back(b.name);
-      diag.error(params_.where("body"), params_.path("body"),
-                 "unknown body '" + params_.text("body") + "'; bodies are: " + join(names, ", "));
-      return;
-    }
+    body_ = sim.body_param(params_, "body", diag, /*need_particles=*/false);
+    if (body_ < 0) return;
     const Body& body = sim.bodies[size_t(body_)];
     for (int d = 0; d < D; ++d) s_[size_t(d)] = body.spacing[size_t(d)];
     if (params_.has("face") && !face_region(sim, diag)) return;
     const auto& g = sim.grid;
-    bool inside = true;
-    for (int d = 0; d < D; ++d)
-      inside = inside && lo_[size_t(d)] >= g.origin[size_t(d)] - 1e-12 &&
-               hi_[size_t(d)] <= g.upper(d) + 1e-12;
-    if (!inside) {
+    if (!g.holds_box(lo_, hi_)) {
       diag.error(params_.where(), params_.path(),
-                 "the source region " + box_text(lo_, hi_) + " is outside the grid " +
-                     box_text(g.origin, upper(g)));
+                 "the source region " + format_box(lo_, hi_) + " is outside the grid " +
+                     format_box(g.origin, g.upper_corner()));
       return;
     }
     lattice(sim);
@@ -197,20 +182,6 @@ class Inflow : public Source<D> {
     Vec y = x;
     for (int d = 0; d < D; ++d) y[size_t(d)] += v_[size_t(d)] * lag;
     return y;
-  }
-  static Vec upper(const Grid<D>& g) {
-    Vec u{};
-    for (int d = 0; d < D; ++d) u[size_t(d)] = g.upper(d);
-    return u;
-  }
-  static std::string box_text(const Vec& lo, const Vec& hi) {
-    std::ostringstream s;
-    s << "[";
-    for (int d = 0; d < D; ++d) s << (d ? ", " : "") << format_number(lo[size_t(d)]);
-    s << "] to [";
-    for (int d = 0; d < D; ++d) s << (d ? ", " : "") << format_number(hi[size_t(d)]);
-    s << "]";
-    return s.str();
   }
 };
 
