@@ -6,6 +6,7 @@
 #include <map>
 #include <sstream>
 
+#include "cli.hpp"
 #include "framework/registry.hpp"
 
 namespace fs = std::filesystem;
@@ -116,4 +117,18 @@ TEST_CASE("every seedNNN config names the paper it reproduces in its first line"
   }
   std::printf("seed configs with their paper named: %d\n", checked);
   CHECK(checked >= 7);
+}
+
+TEST_CASE("every run file in configs/ passes loam check", "[layout]") {
+  // A shipped scene must stay valid when keys or plugins change (renamed keys give exit 2).
+  int checked = 0;
+  for (const auto& e : fs::directory_iterator(fs::path(LOAM_SOURCE_DIR) / "configs")) {
+    if (e.path().extension() != ".yaml") continue;
+    const auto r = loam_test::run_loam("check " + e.path().string());
+    INFO(e.path().filename().string() << ": " << r.output);
+    CHECK(r.exit_code == 0);
+    ++checked;
+  }
+  std::printf("run files in configs/ that pass loam check: %d\n", checked);
+  CHECK(checked >= 15);
 }
