@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "force_inline.hpp"
 #include "grid.hpp"
 
 namespace loam {
@@ -183,7 +184,7 @@ struct HeldFaces {
   /// overshoot: the normal velocity t v_1 falls with the distance t h. Only the position
   /// changes, never the velocity, so no momentum is added. Comparisons keep a NaN a NaN, for
   /// Simulation::check_particles.
-  double moved(int d, double x, double dx) const {
+  LOAM_FORCE_INLINE double moved(int d, double x, double dx) const {
     const double to = x + dx, lo = lower[size_t(d)], hi = upper[size_t(d)];
     if (to <= lo) return lo + 0.5 * (x - lo);
     if (to >= hi) return hi - 0.5 * (hi - x);

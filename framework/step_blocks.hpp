@@ -13,6 +13,7 @@
 #include <memory>
 #include <vector>
 
+#include "force_inline.hpp"
 #include "particles.hpp"
 #include "shape_function.hpp"
 #include "tensor.hpp"
@@ -72,14 +73,14 @@ void for_each_node(size_t num_nodes, int threads, F&& f) {
 /// The FLIP/PIC blend of the particle velocity update: FLIP adds the interpolated grid
 /// acceleration to the particle's own velocity (no dissipation, noisy where nodes are nearly
 /// empty), PIC takes the interpolated grid velocity (smooth, dissipative); `flip` in [0, 1].
-inline double flip_pic(double flip, double v, double dt, double a_grid, double v_grid) {
+LOAM_FORCE_INLINE double flip_pic(double flip, double v, double dt, double a_grid, double v_grid) {
   return flip * (v + dt * a_grid) + (1.0 - flip) * v_grid;
 }
 
 /// Stencil entry kp of particle p (kp = k * kBlock + p) adds v_I (x) grad N_I to l.
 template <int D>
-inline void add_velocity_gradient(double (&l)[D][D], const double* v_node,
-                                  const StencilBlock<D>& st, size_t k, int p) {
+LOAM_FORCE_INLINE void add_velocity_gradient(double (&l)[D][D], const double* v_node,
+                                             const StencilBlock<D>& st, size_t k, int p) {
   for (int j = 0; j < D; ++j) {
     const double gj = st.grad[(k * D + size_t(j)) * kBlock + size_t(p)];
     for (int i = 0; i < D; ++i) l[i][j] += v_node[i] * gj;
@@ -88,7 +89,7 @@ inline void add_velocity_gradient(double (&l)[D][D], const double* v_node,
 
 /// Store particle p's velocity gradient in the block layout the materials read.
 template <int D>
-inline void store_velocity_gradient(const double (&l)[D][D], double* L, int p) {
+LOAM_FORCE_INLINE void store_velocity_gradient(const double (&l)[D][D], double* L, int p) {
   for (int i = 0; i < D; ++i)
     for (int j = 0; j < D; ++j) L[size_t(i * D + j) * kBlock + size_t(p)] = l[i][j];
 }
@@ -106,8 +107,9 @@ std::array<double*, D * D> deformation_gradient_block(Particles<D>& P, int handl
 /// V <- det(I + L dt) V and, when F is stored, F <- (I + L dt) F for particle p of the block;
 /// returns the volume ratio J = det(I + L dt).
 template <int D>
-inline double update_volume_and_deformation(const double (&l)[D][D], double dt, double& V,
-                                            const std::array<double*, D * D>& F, int p) {
+LOAM_FORCE_INLINE double update_volume_and_deformation(const double (&l)[D][D], double dt,
+                                                       double& V,
+                                                       const std::array<double*, D * D>& F, int p) {
   const double J = det_increment<D>(l, dt);
   V *= J;
   if (F[0]) update_deformation_gradient<D>(F, l, dt, p);

@@ -2,6 +2,7 @@
 // Small tensor helpers on Voigt-stored stress (xx yy zz xy yz xz) for D-dimensional kinematics.
 #include <array>
 
+#include "force_inline.hpp"
 #include "particles.hpp"
 
 namespace loam {
@@ -83,7 +84,7 @@ inline void voigt_to_matrix(const double (&v)[NS], double (&s)[3][3]) {
 /// Volume ratio det(I + L dt) of one explicit step: V^{n+1} = det(I + L dt) V^n, the exact
 /// Jacobian of the particle motion x^{n+1} = x^n + v dt in a linear velocity field.
 template <int D>
-inline double det_increment(const double (&l)[D][D], double dt) {
+LOAM_FORCE_INLINE double det_increment(const double (&l)[D][D], double dt) {
   if constexpr (D == 1) {
     return 1.0 + l[0][0] * dt;
   } else if constexpr (D == 2) {
@@ -101,8 +102,8 @@ inline double det_increment(const double (&l)[D][D], double dt) {
 /// F^{n+1} = (I + L dt) F^n for particle p of a block; F holds the D*D component columns
 /// (F_ij at index i*D + j) at the block start.
 template <int D>
-inline void update_deformation_gradient(const std::array<double*, D * D>& F,
-                                        const double (&l)[D][D], double dt, int p) {
+LOAM_FORCE_INLINE void update_deformation_gradient(const std::array<double*, D * D>& F,
+                                                   const double (&l)[D][D], double dt, int p) {
   double f[D][D];
   for (int i = 0; i < D; ++i)
     for (int j = 0; j < D; ++j) f[i][j] = F[size_t(i * D + j)][p];

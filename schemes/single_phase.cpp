@@ -188,11 +188,14 @@ class SinglePhase : public Scheme<D> {
     }
     for (int c = 0; c < NS; ++c) sig[size_t(c)] = P.col(P.stress, c) + b;
     double* g = node_.data();
+    const std::array<double, D> gravity = sim.gravity;
     for (int p = 0; p < count; ++p) {
+      // Particle values in locals: the node stores below could alias the particle columns.
+      const double mp = m[p];
       double mv[D], body[D], sv[D][D];
       for (int d = 0; d < D; ++d) {
-        mv[d] = m[p] * v[size_t(d)][p];
-        body[d] = m[p] * sim.gravity[size_t(d)] + (fe[size_t(d)] ? fe[size_t(d)][p] : 0.0);
+        mv[d] = mp * v[size_t(d)][p];
+        body[d] = mp * gravity[size_t(d)] + (fe[size_t(d)] ? fe[size_t(d)][p] : 0.0);
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * sig[size_t(voigt_index(d, j))][p];
       }
       for (int k = 0; k < npp; ++k) {
@@ -200,7 +203,7 @@ class SinglePhase : public Scheme<D> {
         const double w = st.w[kp];
         double* r = g + size_t(st.node[kp]) * S;
         if constexpr (MOMENTUM) {
-          r[kMass] += w * m[p];
+          r[kMass] += w * mp;
           for (int d = 0; d < D; ++d) r[kMomentum + d] += w * mv[d];
         }
         if constexpr (FORCE) {
@@ -278,6 +281,7 @@ class SinglePhase : public Scheme<D> {
       x[size_t(d)] = P.col(P.position, d) + b;
     }
     const double* g = node_.data();
+    double* remap = vel_.data();
     // Locals, not members: the stores through v and x could alias them and force reloads.
     const double flip = flip_;
     const HeldFaces<D> walls = sim.held_faces;
@@ -293,20 +297,21 @@ class SinglePhase : public Scheme<D> {
           a[d] += w * r[kForce + d];
         }
       }
-      double v2 = 0;
+      double v2 = 0, vp[D];
       for (int d = 0; d < D; ++d) {
-        double& vp = v[size_t(d)][p];
-        vp = flip_pic(flip, vp, dt, a[d], vn[d]);
-        v2 += vp * vp;
+        vp[d] = flip_pic(flip, v[size_t(d)][p], dt, a[d], vn[d]);
+        v[size_t(d)][p] = vp[d];
+        v2 += vp[d] * vp[d];
         if constexpr (MOVE) x[size_t(d)][p] = walls.moved(d, x[size_t(d)][p], dt * vn[d]);
       }
       max_v2 = std::max(max_v2, v2);
       if constexpr (REMAP) {
+        const double mp = m[p];
         for (int k = 0; k < npp; ++k) {
           const size_t kp = size_t(k) * kBlock + size_t(p);
-          const double wm = st.w[kp] * m[p];
-          double* r = vel_.data() + size_t(st.node[kp]) * D;
-          for (int d = 0; d < D; ++d) r[d] += wm * v[size_t(d)][p];
+          const double wm = st.w[kp] * mp;
+          double* r = remap + size_t(st.node[kp]) * D;
+          for (int d = 0; d < D; ++d) r[d] += wm * vp[d];
         }
       }
     }
