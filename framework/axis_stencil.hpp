@@ -18,27 +18,34 @@ struct AxisStencil {
   void tensor_product(int count, StencilBlock<D>& out) const {
     constexpr int K = ipow(M, D);
     for (int k = 0; k < K; ++k) {
-      int j[D];
-      for (int d = 0, r = k; d < D; ++d, r /= M) j[d] = r % M;
-      int32_t* node_k = out.node.data() + size_t(k) * kBlock;
-      double* w_k = out.w.data() + size_t(k) * kBlock;
+      // Entry k is node j[0] along x, j[1] along y, ...: N = prod_d w_d, dN/dx_d = dw_d prod_e!=d
+      // w_e. One fused loop per entry (node, weight and gradients); the outputs are restrict:
+      // they never overlap this block's per-axis arrays.
+      const double* wa[D];
+      const double* dwa[D];
+      const int32_t* na[D];
+      for (int d = 0, r = k; d < D; ++d, r /= M) {
+        wa[d] = w[d][r % M];
+        dwa[d] = dw[d][r % M];
+        na[d] = node[d][r % M];
+      }
+      int32_t* __restrict node_k = out.node.data() + size_t(k) * kBlock;
+      double* __restrict w_k = out.w.data() + size_t(k) * kBlock;
+      double* __restrict grad_k = out.grad.data() + size_t(k) * D * kBlock;
       for (int p = 0; p < count; ++p) {
         int32_t n = 0;
         double wp = 1.0;
         for (int d = 0; d < D; ++d) {
-          n += node[d][j[d]][p];
-          wp *= w[d][j[d]][p];
+          n += na[d][p];
+          wp *= wa[d][p];
         }
         node_k[p] = n;
         w_k[p] = wp;
-      }
-      for (int d = 0; d < D; ++d) {
-        double* gr = out.grad.data() + (size_t(k) * D + size_t(d)) * kBlock;
-        for (int p = 0; p < count; ++p) {
-          double gp = dw[d][j[d]][p];
+        for (int d = 0; d < D; ++d) {
+          double gp = dwa[d][p];
           for (int e = 0; e < D; ++e)
-            if (e != d) gp *= w[e][j[e]][p];
-          gr[p] = gp;
+            if (e != d) gp *= wa[e][p];
+          grad_k[size_t(d) * kBlock + size_t(p)] = gp;
         }
       }
     }
