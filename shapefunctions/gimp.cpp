@@ -221,30 +221,47 @@ class Gimp : public ShapeFunction<D> {
         // lp <= h/2, nearest node b, r = (x_p - x_b)/h in [-1/2, 1/2]: of the kink terms only
         // E(r) is non-zero, so S_b+1 = max(r, 0) + E(r), S_b-1 = max(-r, 0) + E(r) and
         // S_b = 1 - S_b-1 - S_b+1 (= 1 - |r| - 2 E(r)); the same for the gradients.
-        for (int p = 0; p < count; ++p) {
-          const double xi = (x[p] - o) * ih;
-          const double b = double(first[p] + 1);
-          const double r = xi - b;
-          const double a = lp[p] * ih;  // half-width in cells
-          const double gs = 0.5 / a * ih, e = pos(a - std::fabs(r)), E = e * e * (0.25 / a);
-          const double wp = pos(r) + E, wm = pos(-r) + E;
-          const double gp = (pos(r + a) - pos(r - a)) * gs, gm = (pos(-r - a) - pos(a - r)) * gs;
-          // Fold the ghost node b-1 = -1 (b == 0) or b+1 = n+1 (b == n) into its two inner
-          // neighbours, as in bspline2.cpp: a field known on the grid is extrapolated linearly
-          // to the ghost, u_-1 = 2 u_0 - u_1, so N_0 += 2 N_-1, N_1 -= N_-1 (and mirrored at n).
-          // Constants and linear fields take exactly those ghost values, so partition of unity,
-          // sum dN = 0 and linear reproduction hold up to and on the boundary; at the boundary
-          // node the weights become the linear hat (S_0 = 1 - r, S_1 = r for 0 <= r < 1/2), so
-          // a particle on a held face (r = 0) moves with it. lo = [b == 0], hi = [b == n].
-          const double lo = pos(1.0 - b), hi = pos(b - (last - 1.0));
-          const double wg = lo * wm + hi * wp, gg = lo * gm + hi * gp;  // the ghost's N, dN
-          ax.w[d][0][p] = wm - wg;
-          ax.w[d][1][p] = 1.0 - wp - wm + 2.0 * wg;
-          ax.w[d][2][p] = wp - wg;
-          ax.dw[d][0][p] = gm - gg;
-          ax.dw[d][1][p] = -(gp + gm) + 2.0 * gg;
-          ax.dw[d][2][p] = gp - gg;
-        }
+        // A block's particles usually share one half-width (uGIMP: half their body's spacing);
+        // then the two divisions per particle and axis are done once for the block, with the
+        // same operands, so the weights are the same bits.
+        bool uniform = true;
+        for (int p = 1; p < count; ++p) uniform &= lp[p] == lp[0];
+        const double a0 = lp[0] * ih, gs0 = 0.5 / a0 * ih, q0 = 0.25 / a0;
+        auto weights = [&](auto same_width) {
+          for (int p = 0; p < count; ++p) {
+            const double xi = (x[p] - o) * ih;
+            const double b = double(first[p] + 1);
+            const double r = xi - b;
+            double a = a0, gs = gs0, q = q0;  // half-width in cells, gradient and kink factors
+            if constexpr (!decltype(same_width)::value) {
+              a = lp[p] * ih;
+              gs = 0.5 / a * ih;
+              q = 0.25 / a;
+            }
+            const double e = pos(a - std::fabs(r)), E = e * e * q;
+            const double wp = pos(r) + E, wm = pos(-r) + E;
+            const double gp = (pos(r + a) - pos(r - a)) * gs, gm = (pos(-r - a) - pos(a - r)) * gs;
+            // Fold the ghost node b-1 = -1 (b == 0) or b+1 = n+1 (b == n) into its two inner
+            // neighbours, as in bspline2.cpp: a field known on the grid is extrapolated linearly
+            // to the ghost, u_-1 = 2 u_0 - u_1, so N_0 += 2 N_-1, N_1 -= N_-1 (and mirrored at n).
+            // Constants and linear fields take exactly those ghost values, so partition of unity,
+            // sum dN = 0 and linear reproduction hold up to and on the boundary; at the boundary
+            // node the weights become the linear hat (S_0 = 1 - r, S_1 = r for 0 <= r < 1/2), so
+            // a particle on a held face (r = 0) moves with it. lo = [b == 0], hi = [b == n].
+            const double lo = pos(1.0 - b), hi = pos(b - (last - 1.0));
+            const double wg = lo * wm + hi * wp, gg = lo * gm + hi * gp;  // the ghost's N, dN
+            ax.w[d][0][p] = wm - wg;
+            ax.w[d][1][p] = 1.0 - wp - wm + 2.0 * wg;
+            ax.w[d][2][p] = wp - wg;
+            ax.dw[d][0][p] = gm - gg;
+            ax.dw[d][1][p] = -(gp + gm) + 2.0 * gg;
+            ax.dw[d][2][p] = gp - gg;
+          }
+        };
+        if (uniform)
+          weights(std::true_type{});
+        else
+          weights(std::false_type{});
       } else {
         for (int p = 0; p < count; ++p) {
           const double xi = (x[p] - o) * ih;
