@@ -43,8 +43,11 @@ class ShapeFunction {
   static constexpr const char* kind = "shape_function";
   virtual ~ShapeFunction() = default;
 
-  /// Stencil entries per particle (entries may carry zero weight).
+  /// Stencil entries per particle (entries may carry zero weight), for this step: it may change
+  /// in begin_step (CPDI merges its corners' stencils while the domains are small).
   virtual int nodes_per_particle() const = 0;
+  /// The most stencil entries per particle over the run: what a scheme allocates.
+  virtual int max_nodes_per_particle() const { return nodes_per_particle(); }
   /// Node rows along the slowest axis that a particle in cell row r can touch:
   /// [r - rows_below(), r + rows_above()]. Used to colour slabs for race-free scatter.
   virtual int rows_below() const = 0;

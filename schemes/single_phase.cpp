@@ -62,8 +62,8 @@ class SinglePhase : public Scheme<D> {
   void setup(Simulation<D>& sim, Diagnostics&) override {
     node_.assign(sim.grid.num_nodes * S, 0.0);
     vel_.assign(sim.grid.num_nodes * D, 0.0);
-    scratch_ =
-        make_block_scratch<Scratch>(sim.threads, sim.shape->nodes_per_particle(), [](Scratch&) {});
+    scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
+                                           [](Scratch&) {});
   }
 
   std::vector<GridFieldView> grid_fields() const override {

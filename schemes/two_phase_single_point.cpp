@@ -125,7 +125,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     dp_.assign(P.size(), 0.0);
     if (smooth_) cell_.assign(sim.grid.num_cells * 2, 0.0);
     if (musl_) remap_.assign(sim.grid.num_nodes * 2 * D, 0.0);
-    scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->nodes_per_particle(),
+    scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
   }
 

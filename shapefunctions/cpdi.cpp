@@ -27,8 +27,14 @@
 // (sum_I S_I x_I = x_p, sum_I x_I (x) grad S_I = R R^-1 = I) hold for any non-degenerate domain
 // inside the grid, because they hold for the tent functions at every corner.
 //
-// Stencil: the 2^D linear nodes of each corner's cell, entry k = alpha * 2^D + m, so 4^D entries;
-// node indices repeat when corners share a cell and the scatter/gather simply add them up.
+// Stencil: while every domain spans less than a cell along every axis (2 e_d < h_d, e_d the
+// half-extent of the domain's bounding box), its corners lie in two adjacent cells per axis at
+// most, and the corners' tent stencils are merged into the 3^D nodes b_d .. b_d + 2 from the
+// lowest corner cell b_d: S_I and grad S_I summed per node in the evaluation, so the passes
+// visit 3^D nodes instead of 4^D (2D: 9 instead of 16). Otherwise (a stretched domain) the
+// stencil is the 2^D linear nodes of each corner's cell, entry k = alpha * 2^D + m, 4^D entries,
+// with node indices repeated when corners share a cell (the scatter/gather add them up).
+// begin_step() chooses between the two for the step (nodes_per_particle()).
 // begin_step() turns F into R once per step (field `cpdi_domain`), checks every domain (inverted
 // or degenerate, too stretched, corner outside the grid beyond an open face; corner_bounds) and
 // measures the largest domain extent along the last axis for rows_below()/rows_above().
@@ -50,7 +56,8 @@ class Cpdi : public ShapeFunction<D> {
  public:
   static constexpr const char* name = "cpdi";
   static constexpr const char* summary =
-      "CPDI1: linear functions averaged over particle domains convected with F (4^D nodes)";
+      "CPDI1: linear functions averaged over particle domains convected with F (3^D nodes "
+      "while domains span less than a cell, else 4^D)";
   static Schema schema() {
     Schema s;
     s.real("max_stretch", "-",
@@ -80,7 +87,8 @@ class Cpdi : public ShapeFunction<D> {
         min_jacobian_(p.real("min_jacobian")),
         max_overhang_(p.real("max_overhang")) {}
 
-  int nodes_per_particle() const override { return 1 << (2 * D); }
+  int nodes_per_particle() const override { return merged_ ? ipow(3, D) : 1 << (2 * D); }
+  int max_nodes_per_particle() const override { return 1 << (2 * D); }
   int rows_below() const override { return reach_; }
   int rows_above() const override { return reach_ + 1; }
 
@@ -120,22 +128,123 @@ class Cpdi : public ShapeFunction<D> {
 
   void evaluate(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
                 StencilBlock<D>& out) const override {
+    if (merged_)
+      evaluate_merged(g, P, begin, count, out);
+    else
+      evaluate_corners(g, P, begin, count, out);
+  }
+
+ private:
+  /// 2^-D R^-T per particle of the block (the corner gradient factor), vectorised.
+  void corner_gradient_factor(const double* const* r, int count, double (&A)[D * D][kBlock]) const {
+    for (int p = 0; p < count; ++p) {
+      double m[D][D], a[D][D];
+      for (int d = 0; d < D; ++d)
+        for (int i = 0; i < D; ++i) m[d][i] = r[d * D + i][p];
+      inverse_transpose(m, a, 1.0 / (1 << D));
+      for (int d = 0; d < D; ++d)
+        for (int i = 0; i < D; ++i) A[d * D + i][p] = a[d][i];
+    }
+  }
+
+  /// Corner alpha's coordinate along d and its gradient factor, for particle p.
+  static void corner(const double* const* x, const double* const* r,
+                     const double (&A)[D * D][kBlock], int alpha, int d, int p, double& xc,
+                     double& gd) {
+    xc = x[d][p];
+    gd = 0.0;
+    for (int i = 0; i < D; ++i) {
+      const double s = (alpha >> i) & 1 ? 1.0 : -1.0;
+      xc += s * r[d * D + i][p];
+      gd += s * A[d * D + i][p];
+    }
+  }
+
+  /// Domains under a cell: the corners' tents merged into 3^D nodes per particle.
+  void evaluate_merged(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
+                       StencilBlock<D>& out) const {
+    constexpr int C = 1 << D, K = ipow(3, D);
+    out.count = count;
+    const double* x[D];
+    const double* r[D * D];
+    for (int d = 0; d < D; ++d) x[d] = P.col(P.position, d) + begin;
+    for (int c = 0; c < D * D; ++c) r[c] = P.col(R_, c) + begin;
+    alignas(64) double A[D * D][kBlock];
+    corner_gradient_factor(r, count, A);
+    // Per axis: each corner's cell and tent weights, the lowest corner cell b (the first of the
+    // 3 nodes), and each corner's weights on those 3 nodes: with o = cell - b in {0, 1},
+    // (1 - o) N0, (1 - o) N1 + o N0, o N1 (exact: o is 0 or 1).
+    alignas(64) double e[C][D][3][kBlock], G[C][D][kBlock];
+    alignas(64) int32_t node[D][3][kBlock];
+    for (int d = 0; d < D; ++d) {
+      const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
+      const int last = g.cells[d] - 1, n = g.cells[d];
+      const int32_t stride = int32_t(g.node_stride[d]);
+      alignas(64) int32_t cell[C][kBlock], base[kBlock];
+      alignas(64) double t[C][kBlock];
+      for (int alpha = 0; alpha < C; ++alpha)
+        for (int p = 0; p < count; ++p) {
+          double xc, gd;
+          corner(x, r, A, alpha, d, p, xc, gd);
+          const double xi = (xc - o) * ih;
+          int c = int(xi);  // truncation: negative values are clamped to 0 below anyway
+          c = c < 0 ? 0 : (c > last ? last : c);  // outside: extrapolate the boundary cell
+          cell[alpha][p] = c;
+          t[alpha][p] = xi - c;
+          G[alpha][d][p] = gd;
+        }
+      for (int p = 0; p < count; ++p) {
+        int b = cell[0][p];
+        for (int alpha = 1; alpha < C; ++alpha) b = std::min(b, cell[alpha][p]);
+        base[p] = b;
+      }
+      for (int alpha = 0; alpha < C; ++alpha)
+        for (int p = 0; p < count; ++p) {
+          const double off = double(cell[alpha][p] - base[p]), n1 = t[alpha][p], n0 = 1.0 - n1;
+          e[alpha][d][0][p] = (1.0 - off) * n0;
+          e[alpha][d][1][p] = (1.0 - off) * n1 + off * n0;
+          e[alpha][d][2][p] = off * n1;
+        }
+      for (int j = 0; j < 3; ++j)
+        for (int p = 0; p < count; ++p) {
+          const int i = base[p] + j;  // node n + 1 (all corners in the last cell) has weight 0
+          node[d][j][p] = (i > n ? n : i) * stride;
+        }
+    }
+    for (int k = 0; k < K; ++k) {
+      int jd[D];
+      for (int d = 0, q = k; d < D; ++d, q /= 3) jd[d] = q % 3;
+      int32_t* __restrict node_k = out.node.data() + size_t(k) * kBlock;
+      double* __restrict w_k = out.w.data() + size_t(k) * kBlock;
+      double* __restrict grad_k = out.grad.data() + size_t(k) * D * kBlock;
+      for (int p = 0; p < count; ++p) {
+        int32_t nk = 0;
+        for (int d = 0; d < D; ++d) nk += node[d][jd[d]][p];
+        double w = 0, gr[D] = {};
+        for (int alpha = 0; alpha < C; ++alpha) {
+          double np = 1.0;  // N_I(x_alpha) of this node
+          for (int d = 0; d < D; ++d) np *= e[alpha][d][jd[d]][p];
+          w += np;
+          for (int d = 0; d < D; ++d) gr[d] += G[alpha][d][p] * np;
+        }
+        node_k[p] = nk;
+        w_k[p] = w * (1.0 / C);
+        for (int d = 0; d < D; ++d) grad_k[size_t(d) * kBlock + size_t(p)] = gr[d];
+      }
+    }
+  }
+
+  /// Any domain: the 2^D linear nodes of each corner's cell, 4^D entries.
+  void evaluate_corners(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
+                        StencilBlock<D>& out) const {
     constexpr int C = 1 << D;  // corners, and linear nodes per corner
     out.count = count;
     const double* x[D];
     const double* r[D * D];
     for (int d = 0; d < D; ++d) x[d] = P.col(P.position, d) + begin;
     for (int c = 0; c < D * D; ++c) r[c] = P.col(R_, c) + begin;
-    // A = 2^-D R^-T per particle (the corner gradient factor), vectorised across particles.
     alignas(64) double A[D * D][kBlock];
-    for (int p = 0; p < count; ++p) {
-      double m[D][D], a[D][D];
-      for (int d = 0; d < D; ++d)
-        for (int i = 0; i < D; ++i) m[d][i] = r[d * D + i][p];
-      inverse_transpose(m, a, 1.0 / C);
-      for (int d = 0; d < D; ++d)
-        for (int i = 0; i < D; ++i) A[d * D + i][p] = a[d][i];
-    }
+    corner_gradient_factor(r, count, A);
     // Corner by corner: per-axis tent weights of the corner's cell (as in linear.cpp), then the
     // 2^D entries of that corner.
     alignas(64) double n0[D][kBlock], n1[D][kBlock], G[D][kBlock];
@@ -147,12 +256,8 @@ class Cpdi : public ShapeFunction<D> {
         const int last = g.cells[d] - 1;
         const int32_t stride = int32_t(g.node_stride[d]);
         for (int p = 0; p < count; ++p) {
-          double xc = x[d][p], gd = 0.0;
-          for (int i = 0; i < D; ++i) {
-            const double s = (alpha >> i) & 1 ? 1.0 : -1.0;
-            xc += s * r[d * D + i][p];
-            gd += s * A[d * D + i][p];
-          }
+          double xc, gd;
+          corner(x, r, A, alpha, d, p, xc, gd);
           const double xi = (xc - o) * ih;
           int c = int(xi);  // truncation: negative values are clamped to 0 below anyway
           c = c < 0 ? 0 : (c > last ? last : c);  // outside: extrapolate the boundary cell
@@ -185,8 +290,8 @@ class Cpdi : public ShapeFunction<D> {
     }
   }
 
- private:
   double max_stretch_, min_jacobian_, max_overhang_;
+  bool merged_ = false;  // this step: every domain under a cell along every axis (3^D nodes)
   int F_ = -1, half_ = -1, R_ = -1;
   int reach_ = 1;
   static constexpr size_t kParallelMin =
@@ -254,8 +359,12 @@ class Cpdi : public ShapeFunction<D> {
   /// fine).
   void update_domains(Simulation<D>& sim, std::string& failure) {
     double max_extent = 0;  // along the last axis
+    double max_cells = 0;   // largest half-extent in cells along any axis
     for (auto& set : sim.sets)
-      if (failure.empty()) update_domains(sim, set.particles, failure, max_extent);
+      if (failure.empty()) update_domains(sim, set.particles, failure, max_extent, max_cells);
+    // Merge below a spread of 2 e < h, with a margin so that rounding in the corner coordinates
+    // cannot put two corners two cells apart.
+    merged_ = 2.0 * max_cells < 1.0 - 1e-9;
     // Rows: a corner lies within max_extent of the particle along the last axis, so its cell row
     // differs from the particle's by at most floor(max_extent / h) + 1 (one more than ceil when
     // the ratio is an integer, against round-off); its tent functions reach one row further up.
@@ -263,8 +372,9 @@ class Cpdi : public ShapeFunction<D> {
   }
 
   void update_domains(Simulation<D>& sim, Particles<D>& P, std::string& failure,
-                      double& largest_extent) {
-    double max_extent = largest_extent;
+                      double& largest_extent, double& largest_cells) {
+    double max_extent = largest_extent, max_cells = largest_cells;
+    const auto inv_cell = sim.grid.inv_cell;
     const size_t n = P.size();
     const double* Fc[D * D];
     double* Rc[D * D];
@@ -277,8 +387,8 @@ class Cpdi : public ShapeFunction<D> {
     size_t suspect = n;  // first particle failing a cheap (sufficient) test
 #pragma omp parallel for schedule(static) num_threads(sim.threads) if (n >= kParallelMin) \
     reduction(max                                                                         \
-              : max_extent) reduction(min                                                 \
-                                      : suspect)
+              : max_extent, max_cells) reduction(min                                      \
+                                                 : suspect)
     for (size_t i = 0; i < n; ++i) {
       double f[D][D], frob2 = 0;
       for (int d = 0; d < D; ++d)
@@ -293,10 +403,12 @@ class Cpdi : public ShapeFunction<D> {
         for (int j = 0; j < D; ++j) e += std::fabs(f[d][j] * h0[j][i]);
         ok = ok && x[d][i] - e >= lo[d] && x[d][i] + e <= hi[d];
         if (d == D - 1) max_extent = std::max(max_extent, e);
+        max_cells = std::max(max_cells, e * inv_cell[size_t(d)]);
       }
       if (!ok) suspect = std::min(suspect, i);
     }
     largest_extent = max_extent;
+    largest_cells = max_cells;
     if (suspect == n) return;
     // Exact checks from the first suspect on (the Frobenius test is only sufficient).
     size_t bad = n;

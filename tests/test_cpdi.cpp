@@ -90,7 +90,7 @@ TEST_CASE("cpdi: partition of unity, zero gradient sum, linear reproduction, und
     scatter_positions(*sim, 0.03, 0.97, 1);  // anywhere with the domain inside the grid
     sim->shape->begin_step(*sim);
     REQUIRE(sim->failure.empty());
-    CHECK(sim->shape->nodes_per_particle() == 4);
+    CHECK(sim->shape->nodes_per_particle() == 3);  // merged: domains under a cell
     check_consistency(*sim, "undeformed");
   }
   {
@@ -98,7 +98,7 @@ TEST_CASE("cpdi: partition of unity, zero gradient sum, linear reproduction, und
     scatter_positions(*sim, 0.03, 0.97, 2);
     sim->shape->begin_step(*sim);
     REQUIRE(sim->failure.empty());
-    CHECK(sim->shape->nodes_per_particle() == 16);
+    CHECK(sim->shape->nodes_per_particle() == 9);
     check_consistency(*sim, "undeformed");
   }
   {
@@ -106,7 +106,7 @@ TEST_CASE("cpdi: partition of unity, zero gradient sum, linear reproduction, und
     scatter_positions(*sim, 0.03, 0.97, 3);
     sim->shape->begin_step(*sim);
     REQUIRE(sim->failure.empty());
-    CHECK(sim->shape->nodes_per_particle() == 64);
+    CHECK(sim->shape->nodes_per_particle() == 27);
     check_consistency(*sim, "undeformed");
   }
 }
@@ -172,8 +172,12 @@ TEST_CASE("cpdi: weights and gradients match the paper's corner formulas (1D, 2D
   // c4 = x - r1 + r2, V = 4 |r1 x r2|, S_I = (N(c1) + N(c2) + N(c3) + N(c4)) / 4,
   // grad S_I = 1/V [(N(c1) - N(c3)) (r1y - r2y, r2x - r1x) + (N(c2) - N(c4)) (r1y + r2y, -r1x -
   // r2x)].
-  for (auto F : {std::array<double, 4>{3, 0, 0, 0.5}, std::array<double, 4>{1, 1.5, 0, 1},
-                 std::array<double, 4>{0.8, 1.5, -0.6, 1.2}}) {
+  // The last F keeps the domain under a cell along both axes (spread 2 (|F_x1| + |F_x2|) r0 =
+  // 0.075 and 0.055 m < h = 0.1 m): the corners' stencils are then merged into 3x3 nodes.
+  for (auto F :
+       {std::array<double, 4>{3, 0, 0, 0.5}, std::array<double, 4>{1, 1.5, 0, 1},
+        std::array<double, 4>{0.8, 1.5, -0.6, 1.2}, std::array<double, 4>{1.2, 0.3, -0.2, 0.9}}) {
+    const bool merged = F[0] == 1.2;
     auto sim = make_simulation<2>(cpdi_scene<2>());
     set_F<2>(*sim, F);
     auto& P = sim->sets[0].particles;
@@ -188,6 +192,7 @@ TEST_CASE("cpdi: weights and gradients match the paper's corner formulas (1D, 2D
       P.col(P.position, 0)[i] = x, P.col(P.position, 1)[i] = y;
       sim->shape->begin_step(*sim);  // may re-sort when the reach grows
       REQUIRE(sim->failure.empty());
+      REQUIRE(sim->shape->nodes_per_particle() == (merged ? 9 : 16));
       i = sim->sets[0].index_of(0);
       REQUIRE(P.col(P.position, 0)[i] == x);
       const double r1x = F[0] * h0, r1y = F[2] * h0, r2x = F[1] * h0, r2y = F[3] * h0;
@@ -213,7 +218,10 @@ TEST_CASE("cpdi: weights and gradients match the paper's corner formulas (1D, 2D
         "h * gradients) %.2e, up to %zu distinct nodes per particle\n",
         F[0], F[1], F[2], F[3], worst, nodes);
     CHECK(worst < 1e-13);
-    CHECK(nodes > 9);  // the deformed domain reaches beyond the 3x3 nodes of an undeformed one
+    if (merged)
+      CHECK(nodes <= 9);
+    else
+      CHECK(nodes > 9);  // the deformed domain reaches beyond the 3x3 nodes of an undeformed one
   }
 }
 
@@ -386,4 +394,39 @@ TEST_CASE("vibrating bar with cpdi through the CLI: period and energy (docs/veri
   CHECK(v["periods_observed"].get<double>() >= 9);
   CHECK(period_error < 0.01);
   CHECK(drift < 0.01);
+}
+
+TEST_CASE(
+    "cpdi: the stencil switches between 3^D merged and 4^D corner nodes as domains grow "
+    "and shrink, mid-run",
+    "[shape][unit]") {
+  // The scheme allocates for max_nodes_per_particle() and dispatches on nodes_per_particle()
+  // every step: the nodal mass of each step must be the particles' mass whichever stencil the
+  // step used (partition of unity through the scatter).
+  auto sim = make_simulation<2>(cpdi_scene<2>());
+  auto& P = sim->sets[0].particles;
+  double particle_mass = 0;
+  for (size_t i = 0; i < P.size(); ++i) particle_mass += P.col(P.mass)[i];
+  auto nodal_mass = [&] {
+    for (const auto& f : sim->scheme->grid_fields())
+      if (f.name == "mass") {
+        double m = 0;
+        for (size_t n = 0; n < sim->grid.num_nodes; ++n)
+          m += f.base[n * size_t(f.stride) + size_t(f.offset)];
+        return m;
+      }
+    return -1.0;
+  };
+  // F = I: spread h/2 (merged); F_xx = 2.5: 1.25 h (corners); back to I (merged).
+  const std::array<std::array<double, 4>, 3> Fs{{{1, 0, 0, 1}, {2.5, 0, 0, 1}, {1, 0, 0, 1}}};
+  const int expect[3] = {9, 16, 9};
+  for (int s = 0; s < 3; ++s) {
+    set_F<2>(*sim, Fs[size_t(s)]);
+    loam_test::advance(*sim, 1);
+    const double m = nodal_mass();
+    std::printf("cpdi step %d: %d nodes per particle, nodal mass %.15g of %.15g\n", s,
+                sim->shape->nodes_per_particle(), m, particle_mass);
+    CHECK(sim->shape->nodes_per_particle() == expect[s]);
+    CHECK(std::fabs(m - particle_mass) < 1e-12 * particle_mass);
+  }
 }
