@@ -148,15 +148,21 @@ class Cpdi : public ShapeFunction<D> {
   }
 
   /// Corner alpha's coordinate along d and its gradient factor, for particle p.
-  static void corner(const double* const* x, const double* const* r,
-                     const double (&A)[D * D][kBlock], int alpha, int d, int p, double& xc,
-                     double& gd) {
-    xc = x[d][p];
-    gd = 0.0;
-    for (int i = 0; i < D; ++i) {
-      const double s = (alpha >> i) & 1 ? 1.0 : -1.0;
-      xc += s * r[d * D + i][p];
-      gd += s * A[d * D + i][p];
+  /// Coordinate d of corner alpha, x_p + sum_i s_alpha,i r_di, and its gradient factor
+  /// sum_i s_alpha,i A_di, for the block (signs hoisted, so the loop vectorises).
+  static void corner_block(const double* const* x, const double* const* r,
+                           const double (&A)[D * D][kBlock], int alpha, int d, int count,
+                           double* __restrict xc, double* __restrict gd) {
+    double s[D];
+    for (int i = 0; i < D; ++i) s[i] = (alpha >> i) & 1 ? 1.0 : -1.0;
+    for (int p = 0; p < count; ++p) {
+      double xv = x[d][p], gv = 0.0;
+      for (int i = 0; i < D; ++i) {
+        xv += s[i] * r[d * D + i][p];
+        gv += s[i] * A[d * D + i][p];
+      }
+      xc[p] = xv;
+      gd[p] = gv;
     }
   }
 
@@ -182,17 +188,17 @@ class Cpdi : public ShapeFunction<D> {
       const int32_t stride = int32_t(g.node_stride[d]);
       alignas(64) int32_t cell[C][kBlock], base[kBlock];
       alignas(64) double t[C][kBlock];
-      for (int alpha = 0; alpha < C; ++alpha)
+      for (int alpha = 0; alpha < C; ++alpha) {
+        alignas(64) double xc[kBlock];
+        corner_block(x, r, A, alpha, d, count, xc, G[alpha][d]);
         for (int p = 0; p < count; ++p) {
-          double xc, gd;
-          corner(x, r, A, alpha, d, p, xc, gd);
-          const double xi = (xc - o) * ih;
+          const double xi = (xc[p] - o) * ih;
           int c = int(xi);  // truncation: negative values are clamped to 0 below anyway
           c = c < 0 ? 0 : (c > last ? last : c);  // outside: extrapolate the boundary cell
           cell[alpha][p] = c;
           t[alpha][p] = xi - c;
-          G[alpha][d][p] = gd;
         }
+      }
       for (int p = 0; p < count; ++p) {
         int b = cell[0][p];
         for (int alpha = 1; alpha < C; ++alpha) b = std::min(b, cell[alpha][p]);
@@ -255,17 +261,17 @@ class Cpdi : public ShapeFunction<D> {
         const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
         const int last = g.cells[d] - 1;
         const int32_t stride = int32_t(g.node_stride[d]);
+        alignas(64) double xc[kBlock];
+        // G: the grad S_I contribution of this corner is G * N_I(x_alpha).
+        corner_block(x, r, A, alpha, d, count, xc, G[d]);
         for (int p = 0; p < count; ++p) {
-          double xc, gd;
-          corner(x, r, A, alpha, d, p, xc, gd);
-          const double xi = (xc - o) * ih;
+          const double xi = (xc[p] - o) * ih;
           int c = int(xi);  // truncation: negative values are clamped to 0 below anyway
           c = c < 0 ? 0 : (c > last ? last : c);  // outside: extrapolate the boundary cell
           const double t = xi - c;
           n0[d][p] = 1.0 - t;
           n1[d][p] = t;
           base[p] += c * stride;
-          G[d][p] = gd;  // grad S_I contribution of this corner = G * N_I(x_alpha)
         }
       }
       for (int m = 0; m < C; ++m) {
