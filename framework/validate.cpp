@@ -59,6 +59,30 @@ struct Validator {
     return ok;
   }
 
+  /// Each element of the sequence n parsed by parse(node, path, location, value); every bad
+  /// element is reported. True when all parsed (then `out` holds them in order).
+  template <class T, class Parse>
+  bool parse_elements(const YAML::Node& n, const std::string& path, const Location& loc,
+                      std::vector<T>& out, Parse&& parse) {
+    bool ok = true;
+    out.clear();
+    for (size_t i = 0; i < n.size(); ++i) {
+      T v{};
+      const std::string p = path + "." + std::to_string(i);
+      if (parse(n[i], p, location_of(n[i], p, ctx, loc), v))
+        out.push_back(std::move(v));
+      else
+        ok = false;
+    }
+    return ok;
+  }
+  /// An element parser: a real number within spec's bounds.
+  auto real_in_range(const ParamSpec& spec) {
+    return [this, &spec](const YAML::Node& e, const std::string& p, const Location& l, double& v) {
+      return parse_real(e, p, l, v) && in_range(spec, v, p, l);
+    };
+  }
+
   bool parse_vector(const ParamSpec& spec, const YAML::Node& n, const std::string& path,
                     const Location& loc, std::vector<double>& out) {
     int want = resolve_length(spec.length);
@@ -84,18 +108,7 @@ struct Validator {
               ", got " + std::to_string(n.size()));
       return false;
     }
-    bool ok = true;
-    out.clear();
-    for (size_t i = 0; i < n.size(); ++i) {
-      double v = 0;
-      std::string p = path + "." + std::to_string(i);
-      Location l = location_of(n[i], p, ctx, loc);
-      if (parse_real(n[i], p, l, v) && in_range(spec, v, p, l))
-        out.push_back(v);
-      else
-        ok = false;
-    }
-    return ok;
+    return parse_elements(n, path, loc, out, real_in_range(spec));
   }
 
   Params::Value value(const ParamSpec& spec, const YAML::Node& n, const std::string& path,
@@ -151,24 +164,12 @@ struct Validator {
         return {};
       }
       case ParamType::RealList: {
-        ParamSpec any = spec;
-        any.length = -1000;  // any length
         if (!n.IsSequence()) {
           diag.error(loc, path, "expected a list of real numbers, got " + node_text(n));
           return {};
         }
         std::vector<double> out;
-        bool ok = true;
-        for (size_t i = 0; i < n.size(); ++i) {
-          double v;
-          std::string p = path + "." + std::to_string(i);
-          Location l = location_of(n[i], p, ctx, loc);
-          if (parse_real(n[i], p, l, v) && in_range(spec, v, p, l))
-            out.push_back(v);
-          else
-            ok = false;
-        }
-        if (ok) return out;
+        if (parse_elements(n, path, loc, out, real_in_range(spec))) return out;
         return {};
       }
       case ParamType::VectorList: {
@@ -177,16 +178,9 @@ struct Validator {
           return {};
         }
         std::vector<std::vector<double>> out;
-        bool ok = true;
-        for (size_t i = 0; i < n.size(); ++i) {
-          std::vector<double> v;
-          std::string p = path + "." + std::to_string(i);
-          if (parse_vector(spec, n[i], p, location_of(n[i], p, ctx, loc), v))
-            out.push_back(v);
-          else
-            ok = false;
-        }
-        if (ok) return out;
+        auto point = [&](const YAML::Node& e, const std::string& p, const Location& l,
+                         std::vector<double>& v) { return parse_vector(spec, e, p, l, v); };
+        if (parse_elements(n, path, loc, out, point)) return out;
         return {};
       }
       case ParamType::StringList: {
@@ -196,18 +190,16 @@ struct Validator {
           diag.error(loc, path, "expected a list of names, got " + node_text(n));
           return {};
         }
-        bool ok = true;
-        for (size_t i = 0; i < n.size(); ++i) {
-          std::string p = path + "." + std::to_string(i);
-          if (n[i].IsScalar())
-            out.push_back(n[i].Scalar());
-          else {
-            diag.error(location_of(n[i], p, ctx, loc), p,
-                       "expected a name, got " + node_text(n[i]));
-            ok = false;
+        auto name = [&](const YAML::Node& e, const std::string& p, const Location& l,
+                        std::string& v) {
+          if (e.IsScalar()) {
+            v = e.Scalar();
+            return true;
           }
-        }
-        if (ok) return out;
+          diag.error(l, p, "expected a name, got " + node_text(e));
+          return false;
+        };
+        if (parse_elements(n, path, loc, out, name)) return out;
         return {};
       }
       case ParamType::Section:
