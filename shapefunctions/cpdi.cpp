@@ -135,78 +135,86 @@ class Cpdi : public ShapeFunction<D> {
   }
 
  private:
-  /// 2^-D R^-T per particle of the block (the corner gradient factor), vectorised.
-  void corner_gradient_factor(const double* const* r, int count, double (&A)[D * D][kBlock]) const {
+  static constexpr int kCorners = 1 << D;
+
+  /// What both evaluations need of each corner alpha of the block's domains, per axis d: the
+  /// corner's cell (clamped into the grid: outside it, the boundary cell's tents extrapolate),
+  /// its position t = xi - cell in that cell, and its gradient factor G = sum_i s_alpha,i A_di
+  /// with A = 2^-D R^-T (the corner's grad S_I contribution is G N_I(x_alpha)).
+  struct BlockCorners {
+    alignas(64) int32_t cell[kCorners][D][kBlock];
+    alignas(64) double t[kCorners][D][kBlock];
+    alignas(64) double G[kCorners][D][kBlock];
+  };
+
+  void corners_of_block(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
+                        BlockCorners& out) const {
+    const double* x[D];
+    const double* r[D * D];
+    for (int d = 0; d < D; ++d) x[d] = P.col(P.position, d) + begin;
+    for (int c = 0; c < D * D; ++c) r[c] = P.col(R_, c) + begin;
+    alignas(64) double A[D * D][kBlock];
     for (int p = 0; p < count; ++p) {
       double m[D][D], a[D][D];
       for (int d = 0; d < D; ++d)
         for (int i = 0; i < D; ++i) m[d][i] = r[d * D + i][p];
-      inverse_transpose(m, a, 1.0 / (1 << D));
+      inverse_transpose(m, a, 1.0 / kCorners);
       for (int d = 0; d < D; ++d)
         for (int i = 0; i < D; ++i) A[d * D + i][p] = a[d][i];
     }
-  }
-
-  /// Corner alpha's coordinate along d and its gradient factor, for particle p.
-  /// Coordinate d of corner alpha, x_p + sum_i s_alpha,i r_di, and its gradient factor
-  /// sum_i s_alpha,i A_di, for the block (signs hoisted, so the loop vectorises).
-  static void corner_block(const double* const* x, const double* const* r,
-                           const double (&A)[D * D][kBlock], int alpha, int d, int count,
-                           double* __restrict xc, double* __restrict gd) {
-    double s[D];
-    for (int i = 0; i < D; ++i) s[i] = (alpha >> i) & 1 ? 1.0 : -1.0;
-    for (int p = 0; p < count; ++p) {
-      double xv = x[d][p], gv = 0.0;
-      for (int i = 0; i < D; ++i) {
-        xv += s[i] * r[d * D + i][p];
-        gv += s[i] * A[d * D + i][p];
+    for (int alpha = 0; alpha < kCorners; ++alpha) {
+      double s[D];  // the corner's sign vector, hoisted so that the loops vectorise
+      for (int i = 0; i < D; ++i) s[i] = (alpha >> i) & 1 ? 1.0 : -1.0;
+      for (int d = 0; d < D; ++d) {
+        const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
+        const int last = g.cells[d] - 1;
+        double* __restrict G = out.G[alpha][d];
+        alignas(64) double xc[kBlock];  // x_p + sum_i s_i r_di
+        for (int p = 0; p < count; ++p) {
+          double xv = x[d][p], gv = 0.0;
+          for (int i = 0; i < D; ++i) {
+            xv += s[i] * r[d * D + i][p];
+            gv += s[i] * A[d * D + i][p];
+          }
+          xc[p] = xv;
+          G[p] = gv;
+        }
+        for (int p = 0; p < count; ++p) {
+          const double xi = (xc[p] - o) * ih;
+          int c = int(xi);  // truncation: negative values are clamped to 0 below anyway
+          c = c < 0 ? 0 : (c > last ? last : c);  // outside: extrapolate the boundary cell
+          out.cell[alpha][d][p] = c;
+          out.t[alpha][d][p] = xi - c;
+        }
       }
-      xc[p] = xv;
-      gd[p] = gv;
     }
   }
 
   /// Domains under a cell: the corners' tents merged into 3^D nodes per particle.
   void evaluate_merged(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
                        StencilBlock<D>& out) const {
-    constexpr int C = 1 << D, K = ipow(3, D);
+    constexpr int C = kCorners, K = ipow(3, D);
     out.count = count;
-    const double* x[D];
-    const double* r[D * D];
-    for (int d = 0; d < D; ++d) x[d] = P.col(P.position, d) + begin;
-    for (int c = 0; c < D * D; ++c) r[c] = P.col(R_, c) + begin;
-    alignas(64) double A[D * D][kBlock];
-    corner_gradient_factor(r, count, A);
-    // Per axis: each corner's cell and tent weights, the lowest corner cell b (the first of the
-    // 3 nodes), and each corner's weights on those 3 nodes: with o = cell - b in {0, 1},
-    // (1 - o) N0, (1 - o) N1 + o N0, o N1 (exact: o is 0 or 1).
-    alignas(64) double e[C][D][3][kBlock], G[C][D][kBlock];
+    BlockCorners cs;
+    corners_of_block(g, P, begin, count, cs);
+    // Per axis: the lowest corner cell b (the first of the 3 nodes), and each corner's weights
+    // on those 3 nodes: with o = cell - b in {0, 1}, (1 - o) N0, (1 - o) N1 + o N0, o N1
+    // (exact: o is 0 or 1).
+    alignas(64) double e[C][D][3][kBlock];
     alignas(64) int32_t node[D][3][kBlock];
     for (int d = 0; d < D; ++d) {
-      const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
-      const int last = g.cells[d] - 1, n = g.cells[d];
+      const int n = g.cells[d];
       const int32_t stride = int32_t(g.node_stride[d]);
-      alignas(64) int32_t cell[C][kBlock], base[kBlock];
-      alignas(64) double t[C][kBlock];
-      for (int alpha = 0; alpha < C; ++alpha) {
-        alignas(64) double xc[kBlock];
-        corner_block(x, r, A, alpha, d, count, xc, G[alpha][d]);
-        for (int p = 0; p < count; ++p) {
-          const double xi = (xc[p] - o) * ih;
-          int c = int(xi);  // truncation: negative values are clamped to 0 below anyway
-          c = c < 0 ? 0 : (c > last ? last : c);  // outside: extrapolate the boundary cell
-          cell[alpha][p] = c;
-          t[alpha][p] = xi - c;
-        }
-      }
+      alignas(64) int32_t base[kBlock];
       for (int p = 0; p < count; ++p) {
-        int b = cell[0][p];
-        for (int alpha = 1; alpha < C; ++alpha) b = std::min(b, cell[alpha][p]);
+        int b = cs.cell[0][d][p];
+        for (int alpha = 1; alpha < C; ++alpha) b = std::min(b, cs.cell[alpha][d][p]);
         base[p] = b;
       }
       for (int alpha = 0; alpha < C; ++alpha)
         for (int p = 0; p < count; ++p) {
-          const double off = double(cell[alpha][p] - base[p]), n1 = t[alpha][p], n0 = 1.0 - n1;
+          const double off = double(cs.cell[alpha][d][p] - base[p]), n1 = cs.t[alpha][d][p],
+                       n0 = 1.0 - n1;
           e[alpha][d][0][p] = (1.0 - off) * n0;
           e[alpha][d][1][p] = (1.0 - off) * n1 + off * n0;
           e[alpha][d][2][p] = off * n1;
@@ -231,7 +239,7 @@ class Cpdi : public ShapeFunction<D> {
           double np = 1.0;  // N_I(x_alpha) of this node
           for (int d = 0; d < D; ++d) np *= e[alpha][d][jd[d]][p];
           w += np;
-          for (int d = 0; d < D; ++d) gr[d] += G[alpha][d][p] * np;
+          for (int d = 0; d < D; ++d) gr[d] += cs.G[alpha][d][p] * np;
         }
         node_k[p] = nk;
         w_k[p] = w * (1.0 / C);
@@ -240,39 +248,20 @@ class Cpdi : public ShapeFunction<D> {
     }
   }
 
-  /// Any domain: the 2^D linear nodes of each corner's cell, 4^D entries.
+  /// Any domain: the 2^D linear nodes of each corner's cell, 4^D entries, corner by corner
+  /// (the per-axis tent weights of the corner's cell as in linear.cpp).
   void evaluate_corners(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
                         StencilBlock<D>& out) const {
-    constexpr int C = 1 << D;  // corners, and linear nodes per corner
+    constexpr int C = kCorners;  // corners, and linear nodes per corner
     out.count = count;
-    const double* x[D];
-    const double* r[D * D];
-    for (int d = 0; d < D; ++d) x[d] = P.col(P.position, d) + begin;
-    for (int c = 0; c < D * D; ++c) r[c] = P.col(R_, c) + begin;
-    alignas(64) double A[D * D][kBlock];
-    corner_gradient_factor(r, count, A);
-    // Corner by corner: per-axis tent weights of the corner's cell (as in linear.cpp), then the
-    // 2^D entries of that corner.
-    alignas(64) double n0[D][kBlock], n1[D][kBlock], G[D][kBlock];
-    alignas(64) int32_t base[kBlock];
+    BlockCorners cs;
+    corners_of_block(g, P, begin, count, cs);
     for (int alpha = 0; alpha < C; ++alpha) {
+      alignas(64) int32_t base[kBlock];
       for (int p = 0; p < count; ++p) base[p] = 0;
       for (int d = 0; d < D; ++d) {
-        const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
-        const int last = g.cells[d] - 1;
         const int32_t stride = int32_t(g.node_stride[d]);
-        alignas(64) double xc[kBlock];
-        // G: the grad S_I contribution of this corner is G * N_I(x_alpha).
-        corner_block(x, r, A, alpha, d, count, xc, G[d]);
-        for (int p = 0; p < count; ++p) {
-          const double xi = (xc[p] - o) * ih;
-          int c = int(xi);  // truncation: negative values are clamped to 0 below anyway
-          c = c < 0 ? 0 : (c > last ? last : c);  // outside: extrapolate the boundary cell
-          const double t = xi - c;
-          n0[d][p] = 1.0 - t;
-          n1[d][p] = t;
-          base[p] += c * stride;
-        }
+        for (int p = 0; p < count; ++p) base[p] += cs.cell[alpha][d][p] * stride;
       }
       for (int m = 0; m < C; ++m) {
         const int k = alpha * C + m;
@@ -284,13 +273,17 @@ class Cpdi : public ShapeFunction<D> {
         for (int p = 0; p < count; ++p) {
           node[p] = base[p] + offset;
           double np = 1.0;
-          for (int d = 0; d < D; ++d) np *= (m >> d) & 1 ? n1[d][p] : n0[d][p];
+          for (int d = 0; d < D; ++d) {
+            const double t = cs.t[alpha][d][p];
+            np *= (m >> d) & 1 ? t : 1.0 - t;
+          }
           N[p] = np;
           w[p] = np * (1.0 / C);
         }
         for (int d = 0; d < D; ++d) {
           double* gr = out.grad.data() + (size_t(k) * D + size_t(d)) * kBlock;
-          for (int p = 0; p < count; ++p) gr[p] = G[d][p] * N[p];
+          const double* G = cs.G[alpha][d];
+          for (int p = 0; p < count; ++p) gr[p] = G[p] * N[p];
         }
       }
     }
