@@ -51,6 +51,9 @@ class Material {
   /// Largest P-wave speed (m/s) of particles [begin, end) for the CFL time step.
   virtual double wave_speed(const Particles<D>& p, size_t begin, size_t end) const = 0;
   virtual void update_stress(const MaterialBatch<D>& batch) = 0;
+  /// True for a fluid: its stress follows from its current density m/V and its rate alone (no
+  /// skeleton), so a scheme may drive its density (the liquid points of two_phase_double_point).
+  virtual bool is_fluid() const { return false; }
   /// Stored elastic energy of particles [begin, end) (J, per unit thickness in 2D), or NaN if
   /// the model does not define one.
   virtual double strain_energy(const Particles<D>&, size_t, size_t) const {

@@ -40,6 +40,9 @@ class Scheme {
   /// set-up, and particles a source adds later (Simulation::add_particles).
   virtual void initialize_particles(Simulation<D>&, ParticleSet<D>&, size_t /*begin*/,
                                     size_t /*end*/) {}
+  /// Called once the initial fields (bodies[].stress, bodies[].initial) and the materials'
+  /// states are set, before the first frame: e.g. to derive output fields from them.
+  virtual void initial_state(Simulation<D>&) {}
   /// A time-step limit of the scheme's own (e.g. explicit drag), on top of the CFL limit.
   virtual double stable_dt(const Simulation<D>&) const {
     return std::numeric_limits<double>::infinity();

@@ -66,6 +66,12 @@ class ShapeFunction {
   /// not the linear hats, which see only the particle's cell). Loads applied on the particle's
   /// surface rather than at its centre need it, or they could land on nodes without mass.
   virtual bool stencil_covers_domain() const { return true; }
+  /// int N_i dx / h along one axis with nodes 0 .. last (last >= 1 cells): the nodal volume of
+  /// node i in cell units, a factor of V_I = int N_I dOmega (e.g. for a porosity field from
+  /// particle volumes). Default: the linear hat's, 1/2 at the two end nodes and 1 inside; GIMP
+  /// and CPDI, whose weights are the hat averaged over a particle domain inside the grid, share
+  /// it.
+  virtual double axis_node_volume(int i, int last) const { return i == 0 || i == last ? 0.5 : 1.0; }
   /// Fill `out` for particles [begin, begin + count), count <= kBlock. Stencil entries for nodes
   /// outside the grid must carry a valid node index with zero weight and gradient.
   virtual void evaluate(const Grid<D>& grid, const Particles<D>& particles, size_t begin, int count,

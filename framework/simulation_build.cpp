@@ -60,6 +60,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
       const auto& r = s.partition.material_ranges[m];
       if (r.end > r.begin) materials[m]->initialize(s.particles, r.begin, r.end);
     }
+  if (particles_ok) scheme->initial_state(*this);
   for (auto& b : boundaries) b->setup(*this, diag);
   held_faces = HeldFaces<D>(grid, boundaries);
   model_checked = true;

@@ -13,14 +13,16 @@
 //                                                strain sigma_zz = -p - 2 mu tr(D) / 3)
 // Stokes' hypothesis: no bulk viscosity. The stress keeps no memory (no deviatoric stress is
 // integrated), so a rigid rotation (D = 0) produces no stress and no objective rate is needed.
-// The pressure is a function of the density alone: an initial `stress:` of the body is
-// overwritten by the first update (the water starts at p = 0 at rho0 and is compressed by
-// gravity within a few sound-crossing times). Linear rather than logarithmic (p = K ln(rho/rho0))
-// equation of state: the usual weakly compressible choice, with a sound speed independent of
-// the density (below); the two differ by O((rho/rho0 - 1)^2), under 1e-4 K at 1% compression.
-// Note: under a pure spin the schemes' volume update det(I + L dt) = 1 + (w dt)^2 dilates a
-// particle by O((w dt)^2) per step, which this model turns into a tension of about K (w dt)^2
-// per step (measured in the tests: 49 kPa after 90 degrees in 1000 steps with K = 20 MPa).
+// The pressure is a function of the density alone, so an initial `stress:` of the body sets
+// its density (initialize: rho = rho0 (1 + p/K) with p = -tr(sigma)/3, V = m / rho): a
+// hydrostatic body starts in equilibrium instead of being compressed by gravity within a few
+// sound-crossing times. A particle with no initial pressure keeps its volume untouched. Linear
+// rather than logarithmic (p = K ln(rho/rho0)) equation of state: the usual weakly compressible
+// choice, with a sound speed independent of the density (below); the two differ by O((rho/rho0 -
+// 1)^2), under 1e-4 K at 1% compression. Note: under a pure spin the schemes' volume update det(I +
+// L dt) = 1 + (w dt)^2 dilates a particle by O((w dt)^2) per step, which this model turns into a
+// tension of about K (w dt)^2 per step (measured in the tests: 49 kPa after 90 degrees in 1000
+// steps with K = 20 MPa).
 //
 // Sound speed: c^2 = dp/drho = K / rho0 for this equation of state, the same for every density
 // (a compressed particle is stiffer, tangent bulk modulus K rho / rho0, but also denser: the
@@ -70,8 +72,21 @@ class NewtonianFluid : public Material<D> {
                                             : -std::numeric_limits<double>::infinity()) {}
 
   double density() const override { return rho0_; }
+  bool is_fluid() const override { return true; }
 
   void setup(Simulation<D>& sim, int, Diagnostics&) override { h_ = sim.grid.min_cell(); }
+
+  /// The density that gives the initial pressure p = -tr(sigma)/3: V = m / (rho0 (1 + p/K)).
+  /// A particle at p = 0 is left alone (its V is the generator's, m = rho0 V to round-off).
+  void initialize(Particles<D>& P, size_t b, size_t e) override {
+    const double* m = P.col(P.mass);
+    double* V = P.col(P.volume);
+    for (size_t i = b; i < e; ++i) {
+      double p = 0;
+      for (int c = 0; c < 3; ++c) p -= P.col(P.stress, c)[i] / 3;
+      if (p != 0) V[i] = m[i] / (rho0_ * (1 + p / K_));
+    }
+  }
 
   /// Pressure (Pa, compression positive) at density rho.
   double pressure(double rho) const { return std::max(K_ * (rho / rho0_ - 1), p_min_); }

@@ -60,6 +60,7 @@
 #include "framework/simulation.hpp"
 #include "framework/step_blocks.hpp"
 #include "framework/tensor.hpp"
+#include "framework/two_phase_blocks.hpp"
 
 namespace loam {
 
@@ -149,26 +150,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       const double cd = sim.materials[m]->wave_speed(P, r.begin, r.end);
       for (size_t i = r.begin; i < r.end; ++i) {
         const double rho_d = P.col(P.mass)[i] / P.col(P.volume)[i];  // (1 - n) rho_s
-        c2 = std::max(c2, fast_wave_speed2(cd * cd * rho_d, P.col(n_)[i], rho_d));
+        c2 = std::max(c2, fast_wave_speed2(cd * cd * rho_d, P.col(n_)[i], rho_d, Kw_, rho_w_));
       }
     }
     return sim.cfl * sim.grid.min_cell() / (std::sqrt(c2) + sim.max_speed);
-  }
-
-  /// Square of the fastest wave speed of the undamped (drag-free) v-w equations: the largest
-  /// eigenvalue c^2 of K - c^2 R = 0 with the stiffness and mass matrices of the two phases
-  ///   K = [ M + (1 - n)^2 K_w / n   (1 - n) K_w ]    R = diag((1 - n) rho_s, n rho_w),
-  ///       [ (1 - n) K_w             n K_w       ]
-  /// (M the skeleton's constrained modulus): c^2 = (b + sqrt(b^2 - 4 a c0)) / (2 a) with a =
-  /// det R, b = K11 R22 + K22 R11, c0 = det K = M n K_w. The drag couples the phases and slows
-  /// the wave towards the undrained one, sqrt((M + K_w/n) / rho_sat), but with a large
-  /// permeability (or the explicit part of the update) the fast wave is this one: 12 % faster
-  /// for seed 001 (1857 vs 1664 m/s), where the undrained speed let USL diverge at cfl 0.72.
-  double fast_wave_speed2(double M, double n, double rho_d) const {
-    const double K11 = M + (1 - n) * (1 - n) * Kw_ / n, K22 = n * Kw_;
-    const double R11 = rho_d, R22 = n * rho_w_;
-    const double a = R11 * R22, b = K11 * R22 + K22 * R11, c0 = M * n * Kw_;
-    return (b + std::sqrt(std::max(0.0, b * b - 4 * a * c0))) / (2 * a);
   }
 
   /// The pore water's share of the energies: kinetic 1/2 m_w |w|^2 and momentum m_w w with
@@ -461,11 +446,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       for (int d = 0; d < D; ++d) {
         const double v = r[kV + d] / ms, w = mw > tol ? r[kW + d] / mw : v;
         const double F = r[kF + d], Fw = r[kFw + d];
-        const double a11 = mw / dt + Q, a22 = ms / dt + Q;
-        const double b1 = mw * w / dt + Fw, b2 = ms * v / dt + F - Fw;
-        const double det = a11 * a22 - Q * Q;
-        double wn = (b1 * a22 + Q * b2) / det, vn = (a11 * b2 + Q * b1) / det;
-        if (mw <= tol) wn = vn;
+        const auto s = solve_drag_implicit(ms, mw, Q, dt, ms * v / dt + F - Fw, mw * w / dt + Fw);
+        const double vn = s.solid, wn = mw <= tol ? s.solid : s.water;
         r[kV + d] = solved[d] = vn;
         r[kW + d] = solved[D + d] = wn;
         r[kF + d] = (vn - v) / dt;
@@ -474,33 +456,16 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     });
   }
 
-  /// A condition that holds one phase of a node component and leaves the other free (a fixed
-  /// skeleton on a drained face: fixed + drained, or fixed with phase: solid; a water-only
-  /// fixity) changed that phase's velocity after the coupled solve, in which it was still free.
-  /// The free phase must see the held velocity through the drag: its row is solved again with
-  /// the partner's new velocity, e.g. for the water
-  ///   (m_w/dt + Q) w'' = m_w w/dt + F_w + Q v'_c   =>   w'' = w' + Q (v'_c - v') / (m_w/dt + Q).
-  /// Without this the water leaving a fixed drained base is dragged by the fictitious free-solid
-  /// velocity of the solve (over-drainage near the face). A component whose phases both changed
-  /// (both held, tied by impermeable, damped by a dashpot) is left as its conditions set it.
+  /// A phase held by a condition drags its free partner (framework/two_phase_blocks.hpp).
   void follow_held_phase(Simulation<D>& sim, double dt) {
     const double tol = sim.mass_tolerance;
     for_each_record(sim, [&](double* r, size_t i) {
       const double* solved = solved_.data() + i * 2 * D;
       const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
       if (ms <= tol || mw <= tol || !(Q > 0)) return;
-      for (int d = 0; d < D; ++d) {
-        const double dv = r[kV + d] - solved[d], dw = r[kW + d] - solved[D + d];
-        if (dv != 0.0 && dw == 0.0) {
-          const double c = Q * dv / (mw / dt + Q);
-          r[kW + d] += c;
-          r[kFw + d] += c / dt;
-        } else if (dw != 0.0 && dv == 0.0) {
-          const double c = Q * dw / (ms / dt + Q);
-          r[kV + d] += c;
-          r[kF + d] += c / dt;
-        }
-      }
+      for (int d = 0; d < D; ++d)
+        loam::follow_held_phase(ms, mw, Q, dt, solved[d], solved[D + d], r[kV + d], r[kW + d],
+                                r[kF + d], r[kFw + d]);
     });
   }
 

@@ -48,6 +48,20 @@ class BSpline2 : public ShapeFunction<D> {
   int rows_below() const override { return 1; }
   int rows_above() const override { return 2; }
 
+  /// int N_i dx / h of the boundary-modified functions: the interior B-spline centred at i
+  /// clipped to [0, last], plus its share of the folded ghosts (N_0 + 2 N_-1, N_1 - N_-1 and
+  /// likewise at the last node), from the B-spline's cumulative integral. 13/24 and 23/24 for
+  /// the first two nodes of a long axis, 1 inside.
+  double axis_node_volume(int i, int last) const override {
+    auto clipped = [&](int j) { return cumulative(double(last - j)) - cumulative(double(-j)); };
+    double v = clipped(i);
+    if (i == 0) v += 2 * clipped(-1);
+    if (i == 1) v -= clipped(-1);
+    if (i == last) v += 2 * clipped(last + 1);
+    if (i == last - 1) v -= clipped(last + 1);
+    return v;
+  }
+
   void evaluate(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,
                 StencilBlock<D>& out) const override {
     constexpr int M = 3;
@@ -95,6 +109,16 @@ class BSpline2 : public ShapeFunction<D> {
       }
     }
     ax.tensor_product(count, out);
+  }
+
+ private:
+  /// int_-inf^u N(t) dt of the quadratic B-spline centred at 0 (support |t| < 3/2).
+  static double cumulative(double u) {
+    if (u <= -1.5) return 0.0;
+    if (u <= -0.5) return (u + 1.5) * (u + 1.5) * (u + 1.5) / 6;
+    if (u <= 0.5) return 1.0 / 6 + 0.75 * (u + 0.5) - (u * u * u + 0.125) / 3;
+    if (u <= 1.5) return 1 - (1.5 - u) * (1.5 - u) * (1.5 - u) / 6;
+    return 1.0;
   }
 };
 

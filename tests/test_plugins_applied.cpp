@@ -72,6 +72,7 @@ class CountingMaterial : public loam::Material<D> {
   double strain_energy(const loam::Particles<D>& p, size_t b, size_t e) const override {
     return inner_->strain_energy(p, b, e);
   }
+  bool is_fluid() const override { return inner_->is_fluid(); }
 
  private:
   std::unique_ptr<loam::Material<D>> inner_;
@@ -132,6 +133,10 @@ const std::vector<SchemeCase>& schemes() {
        "{type: two_phase_single_point, update: usl, porosity: 0.4, drag: {type: darcy, "
        "hydraulic_conductivity: 1.0e-3}}",
        false},
+      {"two_phase_double_point musl",
+       "{type: two_phase_double_point, porosity: 0.4, drag: {type: darcy, "
+       "hydraulic_conductivity: 1.0e-3}}",
+       true},
   };
   return s;
 }

@@ -817,3 +817,64 @@ TEST_CASE("vibrating bar with gimp and bspline2 through the CLI: period and ener
     CHECK(drift < 0.01);
   }
 }
+
+TEST_CASE("every shape function: axis_node_volume is the integral of the node's weight",
+          "[shape][unit]") {
+  // Reference: V_i / h = int N_i dx / h along one axis (ShapeFunction::axis_node_volume, used
+  // for the double-point scheme's porosity field). linear and bspline2 are functions of the
+  // particle position: integrated by 3-point Gauss on quarter cells (exact for their piecewise
+  // quadratic pieces, which break at nodes and cell centres). gimp and cpdi weigh a particle
+  // domain: the sum of the weights of a regular fill (2 and 3 particles per cell) times the
+  // particle length must give the same factor. Tolerance 1e-12. Grids of 1, 2, 3 and 6 cells
+  // (bspline2's boundary folds overlap on the short ones).
+  const double gx[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, gw[3] = {5.0 / 9, 8.0 / 9, 5.0 / 9};
+  for (const char* sf : {"linear", "bspline2", "gimp", "cpdi"}) {
+    const bool point = std::string(sf) == "linear" || std::string(sf) == "bspline2";
+    for (int cells : {1, 2, 3, 6})
+      for (int ppc : {2, 3}) {
+        if (point && ppc == 3) continue;
+        auto sim = make_simulation<1>("grid: {origin: [0], extent: [" + std::to_string(cells) +
+                                      "], cell_size: 1}\nshape_function: " + sf +
+                                      "\nbodies:\n  - {name: b, generator: {type: box, min: [0], "
+                                      "max: [" +
+                                      std::to_string(cells) +
+                                      "]}, particles_per_cell: " + std::to_string(ppc) +
+                                      ", material: {type: linear_elastic, E: 1, nu: 0, density: "
+                                      "1}}\ntime: {end: 1}\n");
+        auto& P = sim->sets[0].particles;
+        std::vector<double> weight;  // quadrature weight of each particle
+        if (point) {
+          std::vector<double> x;
+          for (int c = 0; c < cells; ++c)
+            for (int q = 0; q < 4; ++q)
+              for (int g = 0; g < 3; ++g) {
+                x.push_back(c + 0.25 * q + 0.125 * (1 + gx[g]));
+                weight.push_back(0.125 * gw[g]);
+              }
+          P.resize(x.size());
+          for (size_t i = 0; i < x.size(); ++i) P.col(P.position)[i] = x[i];
+        } else {
+          weight.assign(P.size(), 1.0 / ppc);
+        }
+        std::vector<double> V(size_t(cells + 1), 0.0);
+        loam::StencilBlock<1> st;
+        st.allocate(sim->shape->max_nodes_per_particle());
+        sim->shape->begin_step(*sim);
+        for (size_t b = 0; b < P.size(); b += loam::kBlock) {
+          const int count = int(std::min<size_t>(loam::kBlock, P.size() - b));
+          sim->shape->evaluate(sim->grid, P, b, count, st);
+          for (int p = 0; p < count; ++p)
+            for (int k = 0; k < st.npp; ++k) {
+              const size_t kp = size_t(k) * loam::kBlock + size_t(p);
+              V[size_t(st.node[kp])] += st.w[kp] * weight[b + size_t(p)];
+            }
+        }
+        double worst = 0;
+        for (int i = 0; i <= cells; ++i)
+          worst = std::max(worst, std::fabs(V[size_t(i)] - sim->shape->axis_node_volume(i, cells)));
+        std::printf("%s, %d cells, %s: max |int N_i - axis_node_volume| = %.1e (V_0 = %.6f)\n", sf,
+                    cells, point ? "Gauss" : (ppc == 2 ? "2 per cell" : "3 per cell"), worst, V[0]);
+        CHECK(worst < 1e-12);
+      }
+  }
+}

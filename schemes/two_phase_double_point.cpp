@@ -1,0 +1,762 @@
+// Soil and water as two sets of material points on one grid, moving separately and free to
+// occupy the same place: the double-point ("dual particle") formulation of seed 003 (its eqs.
+// 1-12; Bandara & Soga 2015; Anura3D's double-point scheme, docs/verification.md F). Pure water,
+// dry soil and saturated soil live in one model.
+//
+// Sets. `solid`: the grains (the skeleton); the material is the effective-stress model (the
+// `stress` field is sigma', tension positive) and its density the grain density rho_s; the
+// particle `mass` is the solid mass (1 - n0) rho_s V, V the point's mixture volume, and the
+// `porosity` field its porosity, conserved with the solid mass: n <- 1 - (1 - n)/J.
+// `liquid`: the water; the material is a fluid (Material::is_fluid: its stress follows from its
+// density m/V and rate, e.g. newtonian_fluid), V is the point's INTRINSIC water volume, so
+// m/V is the intrinsic water density rho_w; its `porosity` field is the porosity of its grid
+// cell (below) and `pore_pressure` the water pressure -tr(sigma_w)/3 (compression positive).
+//
+// Per step (MUSL, lumped masses, drag implicit):
+//   1. particle -> grid, each set with its own points:
+//        solid: m_s, m_s v, F_s = sum[ -V sigma' grad N + m_s g N + f_ext N ],
+//               drag Q_I = sum[ V Q_p N ] (Q per unit mixture volume from the drag plugin, at
+//               the solid point's porosity), solid volume V_s,I = sum[ (1 - n) V N ];
+//               and per grid cell the solid volume V_s,c = sum (1 - n) V;
+//        liquid: m_w, m_w w, F_w = sum[ m_w g N + f_ext N ] and the weak form of div sigma_w
+//               over the mixture, G_I = sum[ -(V/n_c) sigma_w grad N ], V/n_c the mixture
+//               volume whose pores the point fills, n_c = 1 - V_s,c / V_c the porosity of its
+//               cell (cell_porosity: the liquid points of a full cell integrate over the cell,
+//               as Anura3D's liquid weights V_cell V_p / sum V_liquid do).
+//   2. grid: the porosity field n_I = 1 - V_s,I / V_I (V_I = int N_I dOmega, the nodal volume of
+//      the shape function, ShapeFunction::axis_node_volume), clamped to [0, 1]: from the solid
+//      points only, so it rises to 1 where the grains spread or are absent. The liquid stress is
+//      shared as seed 003 eqs. 8-9 do:
+//        F_w += n_I G_I,   F_s += (1 - n_I) G_I,
+//      i.e. the water gets n div sigma_w = div(n sigma_w) + p grad n and the skeleton
+//      (1 - n) div sigma_w = div((1 - n) sigma_w) - p grad n: the porosity-gradient term p grad n
+//      is split between the phases without differentiating n (the nodal n times the weak form of
+//      div sigma_w, as the single-point scheme does for -n grad p). Loads, the face forces of
+//      boundary conditions (on the mixture F_s + F_w and the water F_w) and local damping (on the
+//      solid) come in; then per node and component the momentum equations of the two phases with
+//      the drag implicit (solve_drag_implicit, framework/two_phase_blocks.hpp):
+//        (m_w/dt + Q) w' - Q v' = m_w w/dt + F_w,   -Q w' + (m_s/dt + Q) v' = m_s v/dt + F_s.
+//      Drag acts only where both phases are present (Q comes from solid points, and a node
+//      without water mass takes no water velocity). A node with one phase integrates it alone.
+//      Boundary conditions act on both phases (Simulation::constrain_update: a fixed or slip face
+//      is impermeable for the liquid points too), then a phase whose partner was held is solved
+//      again against it (follow_held_phase).
+//   3. grid -> particle (MUSL): FLIP/PIC update of each set's velocity from its phase's nodal
+//      velocity and acceleration, the new momenta re-mapped to the grid with the points still at
+//      x^n (Sulsky 1995), velocity gradients from the re-mapped velocities on the same stencil,
+//      then each point moves with its phase's updated grid velocity.
+//   4. particle update: solid: V <- det(I + L_s dt) V, F, n <- 1 - (1 - n)/J and the
+//      material's sigma' (Jaumann rate), one call per block. Liquid: the intrinsic density
+//      from both mass balances (seed 003 eq. 12, with its sign: compression raises rho_w),
+//        -(1/rho_w) D rho_w/Dt = div u_w + ((1 - n)/n) div u_s + (1/n) grad n . (u_w - u_s),
+//      i.e. V <- det(I + L_w dt) V (1 + dt [((1 - n)/n) div u_s + (1/n) grad n . (u_w - u_s)])
+//      with n = n_c its cell's porosity and grad n, u_s and div u_s interpolated at the liquid
+//      point from the grid (u_s from the nodes that carry solid mass); in pure water (n = 1) it
+//      is the single-phase update.
+//      The fluid material then gives sigma_w from m/V and L_w (pressure, viscosity, cavitation).
+// Time step: the CFL limit of the materials, and of the fastest wave of the drag-free two-phase
+// equations at every solid point (fast_wave_speed2 with the liquid materials' stiffest K_w);
+// no drag limit: the implicit drag leaves the time step independent of the permeability
+// (Anura3D's explicit drag needs dt < 2 rho k / mu).
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "framework/drag.hpp"
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+#include "framework/step_blocks.hpp"
+#include "framework/tensor.hpp"
+#include "framework/two_phase_blocks.hpp"
+
+namespace loam {
+
+template <int D>
+class TwoPhaseDoublePoint : public Scheme<D> {
+ public:
+  static constexpr const char* name = "two_phase_double_point";
+  static constexpr const char* summary =
+      "soil and water as separate solid and liquid points on one grid (double-point, seed 003): "
+      "pure water, dry and saturated soil in one model; implicit nodal drag";
+  static Schema schema() {
+    Schema s;
+    s.plugin("drag", "drag", "drag law between the liquid and the solid points (darcy, ergun)")
+        .required();
+    s.real("porosity", "-", "initial porosity n0 of the solid bodies (0 < n0 < 1)")
+        .required()
+        .above(0)
+        .below(1);
+    s.choice("pressure_smoothing", {"cell", "none"},
+             "cell: after every step the liquid points of a grid cell take the cell's mean "
+             "water density (one pressure per cell; removes the point-to-point pressure "
+             "checkerboard); none: every liquid point keeps its own")
+        .def("cell");
+    add_flip_param(s);
+    return s;
+  }
+  explicit TwoPhaseDoublePoint(const Params& p)
+      : drag_(Registry::instance().create<Drag, D>(p.section("drag"))),
+        n0_(p.real("porosity")),
+        flip_(p.real("flip")),
+        smooth_(p.text("pressure_smoothing") == "cell") {}
+
+  int phases() const override { return 2; }
+  std::vector<SetDeclaration> particle_sets() const override {
+    return {{"solid", "soil grains: the skeleton, effective stress, solid mass (1 - n) rho_s V"},
+            {"liquid", "water: a fluid material, intrinsic water volume and density"}};
+  }
+
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    check_materials(sim, diag);
+    n_ = sim.request_field({"porosity",
+                            1,
+                            "-",
+                            "porosity: the solid point's own (solid set), that of the liquid "
+                            "point's grid cell (liquid set)",
+                            {}});
+    p_ = sim.request_field(
+        {"pore_pressure", 1, "Pa", "water pressure -tr(sigma_w)/3, compression positive", {}},
+        kLiquid);
+    drag_->setup(sim, diag);
+    node_.assign(sim.grid.num_nodes * S, 0.0);
+    solved_.assign(sim.grid.num_nodes * 2 * D, 0.0);
+    remap_.assign(sim.grid.num_nodes * 2 * D, 0.0);
+    node_volume(sim);
+    inv_cell_volume_ = 1;
+    for (int d = 0; d < D; ++d) inv_cell_volume_ *= sim.grid.inv_cell[size_t(d)];
+    cell_solid_.assign(sim.grid.num_cells, 0.0);
+    scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
+                                           [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
+    for (auto& set : sim.sets) initialize_particles(sim, set, 0, set.size());
+    if (diag.ok()) fill_pores(sim);
+  }
+
+  /// Solid points: porosity n0, solid mass (1 - n0) rho_s V. Liquid points: the porosity of the
+  /// grid where they are (1 before the first step: the liquid bodies start as given).
+  void initialize_particles(Simulation<D>&, ParticleSet<D>& set, size_t b, size_t e) override {
+    auto& P = set.particles;
+    const bool solid = &set == &solid_set(set);
+    for (size_t i = b; i < e; ++i) {
+      P.col(n_)[i] = solid ? n0_ : 1.0;
+      if (solid) P.col(P.mass)[i] *= 1 - n0_;
+    }
+  }
+
+  /// The liquid points' pore_pressure from their initial stress, for the first frame.
+  void initial_state(Simulation<D>& sim) override {
+    water_pressure(sim.sets[kLiquid].particles, 0, sim.sets[kLiquid].size());
+  }
+
+  double stable_dt(const Simulation<D>& sim) const override {
+    // The stiffest water of the run and its density, from the liquid materials' wave speeds.
+    const auto& L = sim.sets[kLiquid];
+    double Kw = 0, rho_w = 0;
+    for (size_t m = 0; m < sim.materials.size(); ++m) {
+      const auto& r = L.partition.material_ranges[m];
+      if (r.end <= r.begin) continue;
+      const double c = sim.materials[m]->wave_speed(L.particles, r.begin, r.end);
+      const double rho = sim.materials[m]->density();
+      Kw = std::max(Kw, rho * c * c);
+      rho_w = std::max(rho_w, rho);
+    }
+    if (!(Kw > 0)) return std::numeric_limits<double>::infinity();  // dry: the materials' CFL
+    const auto& P = sim.sets[kSolid].particles;
+    double c2 = 0;
+    for (size_t m = 0; m < sim.materials.size(); ++m) {
+      const auto& r = sim.sets[kSolid].partition.material_ranges[m];
+      if (r.end <= r.begin) continue;
+      const double cd = sim.materials[m]->wave_speed(P, r.begin, r.end);
+      for (size_t i = r.begin; i < r.end; ++i) {
+        const double rho_d = P.col(P.mass)[i] / P.col(P.volume)[i];  // (1 - n) rho_s
+        c2 = std::max(c2, fast_wave_speed2(cd * cd * rho_d, P.col(n_)[i], rho_d, Kw, rho_w));
+      }
+    }
+    return sim.cfl * sim.grid.min_cell() / (std::sqrt(c2) + sim.max_speed);
+  }
+
+  std::vector<GridFieldView> grid_fields() const override {
+    return {{"mass", 1, node_.data(), S, kMs},
+            {"water_mass", 1, node_.data(), S, kMw},
+            {"velocity", D, node_.data(), S, kV},
+            {"water_velocity", D, node_.data(), S, kW},
+            {"porosity", 1, node_.data(), S, kN}};
+  }
+
+  void step(Simulation<D>& sim, double dt) override {
+    F_ = sim.deformation_gradient;  // may be requested after our set-up
+    for (int s = 0; s < 2; ++s) move_[s].resize(sim.sets[size_t(s)].size() * D);
+    lw_.resize(sim.sets[kLiquid].size() * D * D);
+    with_stencil_size<D>(sim.shape->nodes_per_particle(),
+                         [&](auto npp) { step_phases<decltype(npp)::value>(sim, dt); });
+  }
+
+ private:
+  static constexpr int kSolid = 0, kLiquid = 1;
+  // Node record: solid and water mass, solid and water momentum -> velocity, solid and water
+  // force -> acceleration, the weak form of div sigma_w (G), drag Q, solid volume -> porosity.
+  static constexpr int kMs = 0, kMw = 1, kV = 2, kW = 2 + D, kF = 2 + 2 * D, kFw = 2 + 3 * D,
+                       kG = 2 + 4 * D, kQ = 2 + 5 * D, kN = 3 + 5 * D, S = 4 + 5 * D;
+  static constexpr int NS = Particles<D>::NS;
+  // Smallest porosity a liquid point divides by (its mixture volume V/n): a liquid point inside
+  // a grain-filled region (n_I -> 0 where solid points overlap) keeps a finite weight.
+  static constexpr double kMinPorosity = 1e-3;
+  std::unique_ptr<Drag<D>> drag_;
+  double n0_, flip_;
+  int n_ = -1, p_ = -1, F_ = -1;
+  std::vector<double> node_;
+  std::vector<double> vol_;         // per node: V_I = int N_I dOmega
+  std::vector<double> solved_;      // per node: v', w' of the coupled solve (2 D values)
+  std::vector<double> remap_;       // per node: re-mapped solid then water velocity (2 D values)
+  std::vector<double> move_[2];     // per set and particle: dt v_grid from the re-map pass
+  std::vector<double> cell_solid_;  // per grid cell: solid volume sum (1 - n) V of the step
+  double inv_cell_volume_ = 1;
+  std::vector<double> lw_;          // per liquid point: L_w (D * D values) until its stress update
+  std::vector<double> cell_;        // per grid cell: liquid mass and volume (pressure_smoothing)
+  std::vector<size_t> cell_index_;  // each liquid point's cell
+  bool smooth_ = true;
+  std::vector<double> mixture_force_;  // per node (D values), while boundary forces are added
+  struct Scratch : BlockScratch<D> {
+    std::vector<double> Q;   // drag coefficients of the block
+    long bad_porosity = -1;  // a solid point whose porosity left (0, 1) this step
+  };
+  std::vector<std::unique_ptr<Scratch>> scratch_;
+
+  static ParticleSet<D>& solid_set(ParticleSet<D>& any) {
+    return *(&any - (any.name == "liquid" ? 1 : 0));
+  }
+
+  /// A liquid body needs a fluid material (its stress from its density), a solid body an
+  /// effective-stress model: located errors at the body's material.
+  void check_materials(Simulation<D>& sim, Diagnostics& diag) const {
+    const auto& bl = sim.config.list("bodies");
+    for (size_t b = 0; b < bl.size() && b < sim.materials.size(); ++b) {
+      if (bl[b].has("set") && sim.set_index(bl[b].text("set")) < 0) continue;  // reported
+      const bool liquid = sim.body_set(int(b)) == kLiquid;
+      const bool fluid = sim.materials[b]->is_fluid();
+      if (liquid && !fluid)
+        diag.error(bl[b].where("material"), bl[b].path("material"),
+                   "a body in the liquid set needs a fluid material (e.g. newtonian_fluid): the "
+                   "water's pressure follows from its density; '" +
+                       bl[b].section("material").type() + "' is a soil model");
+      if (!liquid && fluid)
+        diag.error(bl[b].where("material"), bl[b].path("material"),
+                   "'" + bl[b].section("material").type() +
+                       "' is a fluid: put water in the liquid set (set: liquid); the solid set "
+                       "holds the soil grains");
+    }
+  }
+
+  /// V_I = int N_I dOmega = prod_d h_d a_d(i_d), a_d the shape function's per-axis factor.
+  void node_volume(const Simulation<D>& sim) {
+    const Grid<D>& g = sim.grid;
+    vol_.assign(g.num_nodes, 1.0);
+    for (size_t n = 0; n < g.num_nodes; ++n) {
+      const auto ijk = g.node_ijk(n);
+      for (int d = 0; d < D; ++d)
+        vol_[n] *= g.cell[size_t(d)] * sim.shape->axis_node_volume(ijk[size_t(d)], g.cells[d]);
+    }
+  }
+
+  /// The liquid bodies are generated like any body, a point per spacing filling its whole
+  /// volume; where they overlap the soil only the pores hold water. At set-up each liquid point
+  /// keeps the fraction n_c of its volume and mass, n_c the porosity of its grid cell
+  /// (cell_porosity): V <- n_c V, m <- n_c m (intrinsic water volume at the material's density).
+  /// A regular fill thus puts exactly the pore volume of each cell in water; pure water keeps
+  /// its points as they are (n_c = 1).
+  void fill_pores(Simulation<D>& sim) {
+    auto& solid = sim.sets[kSolid].particles;
+    auto& liquid = sim.sets[kLiquid].particles;
+    if (liquid.size() == 0) return;
+    cell_solid_.assign(sim.grid.num_cells, 0.0);
+    for (size_t i = 0; i < solid.size(); ++i)
+      cell_solid_[cell_index(sim.grid, solid, i)] +=
+          (1 - solid.col(n_)[i]) * solid.col(solid.volume)[i];
+    for (size_t i = 0; i < liquid.size(); ++i) {
+      const double n = cell_porosity(cell_index(sim.grid, liquid, i));
+      liquid.col(n_)[i] = n;
+      liquid.col(liquid.volume)[i] *= n;
+      liquid.col(liquid.mass)[i] *= n;
+    }
+  }
+
+  static size_t cell_index(const Grid<D>& g, const Particles<D>& P, size_t i) {
+    size_t c = 0;
+    for (int d = 0; d < D; ++d)
+      c += size_t(g.cell_of(P.col(P.position, d)[i], d)) * size_t(g.cell_stride[d]);
+    return c;
+  }
+  /// Porosity of grid cell c from the solid volume in it, n_c = 1 - V_s,c / V_c in
+  /// [kMinPorosity, 1]: the water fraction of a cell whose pores are full. A liquid point's
+  /// mixture volume is V / n_c, so the liquid points of a full cell integrate over the cell's
+  /// volume (Anura3D's weight V_cell V_p / sum V_liquid), and those of a cell the water only
+  /// partly fills (a free surface) over the part they fill.
+  double cell_porosity(size_t c) const {
+    return std::clamp(1.0 - cell_solid_[c] * inv_cell_volume_, kMinPorosity, 1.0);
+  }
+
+  template <int NPP>
+  void step_phases(Simulation<D>& sim, double dt) {
+    sim.timed("grid", [&] {
+      zero_nodes(node_, sim.threads);
+      zero_nodes(cell_solid_, sim.threads);
+    });
+    sim.timed("p2g", [&] {
+      sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+        if (&s == &sim.sets[kSolid])
+          scatter_solid<NPP>(sim, s, b, c, t);
+        else
+          scatter_liquid<NPP>(sim, s, b, c, t);
+      });
+    });
+    sim.timed("grid", [&] { integrate(sim, dt); });
+    reset_max_speed(scratch_);
+    sim.timed("grid", [&] { zero_nodes(remap_, sim.threads); });
+    sim.timed("g2p_velocity_remap", [&] {
+      sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+        remap<NPP>(sim, s, s.name == "liquid" ? kLiquid : kSolid, dt, b, c, t);
+      });
+    });
+    sim.timed("grid", [&] { remapped_velocities(sim); });
+    sim.timed("g2p_gradient_stress", [&] {
+      sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+        if (&s == &sim.sets[kSolid])
+          update_solid<NPP>(sim, s, dt, b, c, t);
+        else
+          update_liquid<NPP>(sim, s, dt, b, c, t);
+      });
+    });
+    auto& liquid = sim.sets[kLiquid];
+    if (smooth_) sim.timed("pore_pressure", [&] { smooth_liquid_density(sim); });
+    sim.timed("g2p_gradient_stress", [&] {
+      liquid.gather_blocks(
+          [&](size_t b, int c, int t) { liquid_stress(sim, liquid, dt, b, c, t); });
+    });
+    sim.max_speed = max_speed(scratch_);
+    report_bad_porosity(sim);
+  }
+
+  /// A solid point whose porosity left (0, 1) in the step ends the run (Simulation::failure).
+  void report_bad_porosity(Simulation<D>& sim) {
+    for (auto& s : scratch_)
+      if (s->bad_porosity >= 0) {
+        const auto& P = sim.sets[kSolid].particles;
+        const size_t i = size_t(s->bad_porosity);
+        sim.failure = "solid particle " + std::to_string(P.id[i]) +
+                      ": porosity left (0, 1) (n = " + format_number(P.col(n_)[i]) +
+                      "); the skeleton was compressed to zero pore volume or torn apart";
+        s->bad_porosity = -1;
+      }
+  }
+
+  // ------------------------------------------------------------------ particle to grid
+  /// Solid points: mass, momentum, force (effective stress, weight, loads), drag, solid volume.
+  template <int NPP>
+  void scatter_solid(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
+    Particles<D>& P = set.particles;
+    Scratch& sc = *scratch_[size_t(thread)];
+    StencilBlock<D>& st = sc.stencil;
+    sim.shape->evaluate(sim.grid, P, b, count, st);
+    const int npp = NPP ? NPP : st.npp;
+    const double* ms = P.col(P.mass) + b;
+    const double* V = P.col(P.volume) + b;
+    const double* n = P.col(n_) + b;
+    drag_coefficients(P, st, b, count, npp, sc.Q.data());
+    double* g = node_.data();
+    for (int p = 0; p < count; ++p) {
+      const size_t i = b + size_t(p);
+      double mv[D], body[D], sv[D][D];
+      for (int d = 0; d < D; ++d) {
+        mv[d] = ms[p] * P.col(P.velocity, d)[i];
+        const double fe = sim.external_force >= 0 ? P.col(sim.external_force, d)[i] : 0.0;
+        body[d] = ms[p] * sim.gravity[size_t(d)] + fe;
+        for (int j = 0; j < D; ++j) sv[d][j] = V[p] * P.col(P.stress, voigt_index(d, j))[i];
+      }
+      const double vq = V[p] * sc.Q[size_t(p)], vs = (1 - n[p]) * V[p];
+      cell_solid_[cell_index(sim.grid, P, i)] += vs;  // in the stencil: race-free
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        const double w = st.w[kp];
+        double* r = g + size_t(st.node[kp]) * S;
+        r[kMs] += w * ms[p];
+        r[kQ] += w * vq;
+        r[kN] += w * vs;
+        for (int d = 0; d < D; ++d) {
+          r[kV + d] += w * mv[d];
+          double f = w * body[d];
+          for (int j = 0; j < D; ++j)
+            f -= sv[d][j] * st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
+          r[kF + d] += f;
+        }
+      }
+    }
+  }
+
+  /// Drag coefficients of a block of solid points at their porosity; for a speed-dependent law
+  /// (ergun) at their speed relative to the water, the re-mapped water velocity of the last
+  /// step interpolated at the point (still in remap_: it is zeroed after the grid update).
+  void drag_coefficients(const Particles<D>& P, const StencilBlock<D>& st, size_t b, int count,
+                         int npp, double* Q) const {
+    if (!drag_->speed_dependent())
+      return drag_->coefficient(size_t(count), P.col(n_) + b, nullptr, Q);
+    double speed[kBlock];
+    for (int p = 0; p < count; ++p) {
+      double w[D] = {};
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        const double* r = remap_.data() + size_t(st.node[kp]) * 2 * D + D;
+        for (int d = 0; d < D; ++d) w[d] += st.w[kp] * r[d];
+      }
+      double s2 = 0;
+      for (int d = 0; d < D; ++d) {
+        const double rel = w[d] - P.col(P.velocity, d)[b + size_t(p)];
+        s2 += rel * rel;
+      }
+      speed[p] = std::sqrt(s2);
+    }
+    drag_->coefficient(size_t(count), P.col(n_) + b, speed, Q);
+  }
+
+  /// Liquid points: mass, momentum, weight and loads, and the weak form of div sigma_w over
+  /// the mixture volume V/n.
+  template <int NPP>
+  void scatter_liquid(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
+    Particles<D>& P = set.particles;
+    StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
+    sim.shape->evaluate(sim.grid, P, b, count, st);
+    const int npp = NPP ? NPP : st.npp;
+    const double* mw = P.col(P.mass) + b;
+    const double* V = P.col(P.volume) + b;
+    double* n = P.col(n_) + b;
+    double* g = node_.data();
+    for (int p = 0; p < count; ++p) {
+      const size_t i = b + size_t(p);
+      n[p] = cell_porosity(cell_index(sim.grid, P, i));  // the solid set is scattered first
+      const double Vmix = V[p] / n[p];
+      double mv[D], body[D], sv[D][D];
+      for (int d = 0; d < D; ++d) {
+        mv[d] = mw[p] * P.col(P.velocity, d)[i];
+        const double fe = sim.external_force >= 0 ? P.col(sim.external_force, d)[i] : 0.0;
+        body[d] = mw[p] * sim.gravity[size_t(d)] + fe;
+        for (int j = 0; j < D; ++j) sv[d][j] = Vmix * P.col(P.stress, voigt_index(d, j))[i];
+      }
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        const double w = st.w[kp];
+        double* r = g + size_t(st.node[kp]) * S;
+        r[kMw] += w * mw[p];
+        for (int d = 0; d < D; ++d) {
+          r[kW + d] += w * mv[d];
+          r[kFw + d] += w * body[d];
+          double f = 0;
+          for (int j = 0; j < D; ++j)
+            f -= sv[d][j] * st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
+          r[kG + d] += f;
+        }
+      }
+    }
+  }
+
+  // ------------------------------------------------------------------ grid
+  /// Nodal porosity and the shared liquid stress, loads, boundary forces, damping, the coupled
+  /// solve with the drag implicit, the boundary conditions and the re-solve of a phase whose
+  /// partner a condition held.
+  void integrate(Simulation<D>& sim, double dt) {
+    porosity_and_liquid_stress(sim);
+    sim.apply_grid_loads(NodalVector{node_.data(), S, kF});
+    boundary_forces(sim);
+    damp_solid(sim);
+    solve_coupled(sim, dt);
+    GridUpdate u;
+    double* g = node_.data();
+    u.phases[0] = {NodalVector{g, S, kV}, NodalVector{g, S, kF}, NodalVector{g, S, kMs}};
+    u.phases[1] = {NodalVector{g, S, kW}, NodalVector{g, S, kFw}, NodalVector{g, S, kMw}};
+    u.count = 2;
+    u.dt = dt;
+    u.porosity = NodalVector{g, S, kN};
+    sim.constrain_update(u);
+    follow_held_phases(sim, dt);
+  }
+
+  /// n_I = 1 - V_s,I / V_I in [0, 1]; F_w += n_I G_I, F_s += (1 - n_I) G_I (see the header).
+  void porosity_and_liquid_stress(Simulation<D>& sim) {
+    for_each_record(sim, [&](double* r, size_t i) {
+      const double n = std::clamp(1.0 - r[kN] / vol_[i], 0.0, 1.0);
+      r[kN] = n;
+      for (int d = 0; d < D; ++d) {
+        r[kFw + d] += n * r[kG + d];
+        r[kF + d] += (1 - n) * r[kG + d];
+      }
+    });
+  }
+
+  /// Face forces of the boundary conditions act on the mixture (F_s + F_w) and the water F_w
+  /// (GridForces); the solid keeps the difference.
+  void boundary_forces(Simulation<D>& sim) {
+    if (sim.boundaries.empty()) return;
+    mixture_force_.resize(sim.grid.num_nodes * D);
+    for_each_record(sim, [&](const double* r, size_t i) {
+      for (int d = 0; d < D; ++d) mixture_force_[i * D + size_t(d)] = r[kF + d] + r[kFw + d];
+    });
+    GridForces f;
+    f.mixture = NodalVector{mixture_force_.data(), D, 0};
+    f.water = NodalVector{node_.data(), S, kFw};
+    f.porosity = NodalVector{node_.data(), S, kN};
+    f.count = 2;
+    sim.apply_boundary_forces(f);
+    for_each_record(sim, [&](double* r, size_t i) {
+      for (int d = 0; d < D; ++d) r[kF + d] = mixture_force_[i * D + size_t(d)] - r[kFw + d];
+    });
+  }
+
+  /// Local damping (damping:) acts on the solid's momentum balance; the water is damped by the
+  /// drag and its viscosity (damping its force would slow steady seepage).
+  void damp_solid(Simulation<D>& sim) {
+    if (!sim.damping) return;
+    sim.apply_damping(NodeForces{node_.data() + kMs, NodalVector{node_.data(), S, kV},
+                                 NodalVector{node_.data(), S, kF}, sim.grid.num_nodes, S});
+  }
+
+  /// Per node and component the two momentum equations with the drag implicit; a node with one
+  /// phase integrates it alone. The record then holds the new velocities and the accelerations;
+  /// solved_ keeps the velocities of the solve for follow_held_phases().
+  void solve_coupled(Simulation<D>& sim, double dt) {
+    const double tol = sim.mass_tolerance;
+    for_each_record(sim, [&](double* r, size_t i) {
+      double* solved = solved_.data() + i * 2 * D;
+      const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
+      const bool has_s = ms > tol, has_w = mw > tol;
+      for (int d = 0; d < D; ++d) {
+        const double v = has_s ? r[kV + d] / ms : 0.0, w = has_w ? r[kW + d] / mw : 0.0;
+        const double Fs = r[kF + d], Fw = r[kFw + d];
+        double vn = 0, wn = 0;
+        if (has_s && has_w) {
+          const auto s = solve_drag_implicit(ms, mw, Q, dt, ms * v / dt + Fs, mw * w / dt + Fw);
+          vn = s.solid, wn = s.water;
+        } else if (has_s) {
+          vn = v + dt * Fs / ms;
+        } else if (has_w) {
+          wn = w + dt * Fw / mw;
+        }
+        r[kV + d] = solved[d] = vn;
+        r[kW + d] = solved[D + d] = wn;
+        r[kF + d] = has_s ? (vn - v) / dt : 0.0;
+        r[kFw + d] = has_w ? (wn - w) / dt : 0.0;
+      }
+    });
+  }
+
+  void follow_held_phases(Simulation<D>& sim, double dt) {
+    const double tol = sim.mass_tolerance;
+    for_each_record(sim, [&](double* r, size_t i) {
+      const double* solved = solved_.data() + i * 2 * D;
+      const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
+      if (ms <= tol || mw <= tol || !(Q > 0)) return;
+      for (int d = 0; d < D; ++d)
+        follow_held_phase(ms, mw, Q, dt, solved[d], solved[D + d], r[kV + d], r[kW + d], r[kF + d],
+                          r[kFw + d]);
+    });
+  }
+
+  /// f(record, node) for every grid node, in parallel (static schedule).
+  template <class F>
+  void for_each_record(const Simulation<D>& sim, F&& f) {
+    double* g = node_.data();
+    for_each_node(sim.grid.num_nodes, sim.threads, [&](size_t i) { f(g + i * S, i); });
+  }
+
+  // ------------------------------------------------------------------ grid to particle
+  /// MUSL first pass for the points of one phase: FLIP/PIC update of their velocity from the
+  /// phase's nodal velocity and acceleration, the move dt v_grid kept for the gradient pass,
+  /// and the scatter of the new momentum (the points stay at x^n).
+  template <int NPP>
+  void remap(Simulation<D>& sim, ParticleSet<D>& set, int phase, double dt, size_t b, int count,
+             int thread) {
+    Particles<D>& P = set.particles;
+    Scratch& sc = *scratch_[size_t(thread)];
+    StencilBlock<D>& st = sc.stencil;
+    sim.shape->evaluate(sim.grid, P, b, count, st);
+    const int npp = NPP ? NPP : st.npp;
+    const int kv = phase == kSolid ? kV : kW, ka = phase == kSolid ? kF : kFw;
+    const double* g = node_.data();
+    const double* m = P.col(P.mass) + b;
+    double* move = move_[phase].data() + b * D;
+    const double flip = flip_;
+    double max_v2 = sc.max_v2;
+    for (int p = 0; p < count; ++p) {
+      double vg[D] = {}, ag[D] = {};
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        const double w = st.w[kp];
+        const double* r = g + size_t(st.node[kp]) * S;
+        for (int d = 0; d < D; ++d) {
+          vg[d] += w * r[kv + d];
+          ag[d] += w * r[ka + d];
+        }
+      }
+      double v2 = 0, vp[D];
+      for (int d = 0; d < D; ++d) {
+        double& v = P.col(P.velocity, d)[b + size_t(p)];
+        v = vp[d] = flip_pic(flip, v, dt, ag[d], vg[d]);
+        move[size_t(p) * D + size_t(d)] = dt * vg[d];
+        v2 += vp[d] * vp[d];
+      }
+      max_v2 = std::max(max_v2, v2);
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        const double wm = st.w[kp] * m[p];
+        double* r = remap_.data() + size_t(st.node[kp]) * 2 * D + size_t(phase * D);
+        for (int d = 0; d < D; ++d) r[d] += wm * vp[d];
+      }
+    }
+    sc.max_v2 = max_v2;
+  }
+
+  /// Re-mapped momenta to velocities (the node masses of the step), constrained like the update.
+  void remapped_velocities(Simulation<D>& sim) {
+    const double tol = sim.mass_tolerance;
+    for_each_record(sim, [&](const double* g, size_t i) {
+      const double ms = g[kMs], mw = g[kMw];
+      double* r = remap_.data() + i * 2 * D;
+      for (int d = 0; d < D; ++d) {
+        r[d] = ms > tol ? r[d] / ms : 0.0;
+        r[D + d] = mw > tol ? r[D + d] / mw : 0.0;
+      }
+    });
+    sim.constrain(NodalVector{remap_.data(), 2 * D, 0});
+    sim.constrain(NodalVector{remap_.data(), 2 * D, D}, 1);
+  }
+
+  /// Solid points: L_s from the re-mapped solid velocities, volume, F and porosity, the move,
+  /// the effective stress.
+  template <int NPP>
+  void update_solid(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
+                    int thread) {
+    Particles<D>& P = set.particles;
+    Scratch& sc = *scratch_[size_t(thread)];
+    StencilBlock<D>& st = sc.stencil;
+    sim.shape->evaluate(sim.grid, P, b, count, st);
+    const int npp = NPP ? NPP : st.npp;
+    double* L = sc.L.data();
+    const auto F = deformation_gradient_block(P, F_, b);
+    const double* move = move_[kSolid].data() + b * D;
+    for (int p = 0; p < count; ++p) {
+      const size_t i = b + size_t(p);
+      double l[D][D] = {};
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        add_velocity_gradient<D>(l, remap_.data() + size_t(st.node[kp]) * 2 * D, st, size_t(k), p);
+      }
+      move_point(sim, P, i, move + size_t(p) * D);
+      store_velocity_gradient<D>(l, L, p);
+      const double J = update_volume_and_deformation<D>(l, dt, P.col(P.volume)[i], F, p);
+      double& n = P.col(n_)[i];
+      n = 1 - (1 - n) / J;  // solid volume (1 - n) V conserved
+      if (!(n > 0 && n < 1)) sc.bad_porosity = long(i);
+    }
+    sim.update_block_stress(set, b, count, dt, L);
+  }
+
+  /// Liquid points: L_w from the re-mapped water velocities; n, grad n, u_s and div u_s at the
+  /// point from the grid; the intrinsic volume from both mass balances (seed 003 eq. 12, see
+  /// the header); the move. L_w is kept for the stress update after the smoothing.
+  template <int NPP>
+  void update_liquid(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
+                     int thread) {
+    Particles<D>& P = set.particles;
+    Scratch& sc = *scratch_[size_t(thread)];
+    StencilBlock<D>& st = sc.stencil;
+    sim.shape->evaluate(sim.grid, P, b, count, st);
+    const int npp = NPP ? NPP : st.npp;
+    const auto F = deformation_gradient_block(P, F_, b);
+    const double* move = move_[kLiquid].data() + b * D;
+    const double* g = node_.data();
+    for (int p = 0; p < count; ++p) {
+      const size_t i = b + size_t(p);
+      // L_w, and the storage rate sum_I [ (1 - n_I) v_I + n_I w_I ] . grad N_I: the discrete
+      // div((1 - n) u_s) + div(n u_w) with the nodal products, the adjoint of the shared
+      // liquid stress (n_I G_I to the water, (1 - n_I) G_I to the solid).
+      double lw[D][D] = {}, rate = 0;
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        const size_t node = size_t(st.node[kp]);
+        const double* vr = remap_.data() + node * 2 * D;
+        const double n_I = g[node * S + kN];
+        add_velocity_gradient<D>(lw, vr + D, st, size_t(k), p);
+        for (int d = 0; d < D; ++d)
+          rate += ((1 - n_I) * vr[d] + n_I * vr[D + d]) *
+                  st.grad[(size_t(k) * D + size_t(d)) * kBlock + size_t(p)];
+      }
+      move_point(sim, P, i, move + size_t(p) * D);
+      for (int a = 0; a < D; ++a)
+        for (int c = 0; c < D; ++c) lw_[i * D * D + size_t(a * D + c)] = lw[a][c];
+      if (F[0]) update_deformation_gradient<D>(F, lw, dt, p);
+      P.col(P.volume)[i] *= 1 + dt * rate / P.col(n_)[i];  // n_c: its cell's, from the scatter
+    }
+  }
+
+  /// pressure_smoothing: cell: every liquid point of a grid cell (at x^{n+1}) takes the cell's
+  /// mean water density, sum m / sum V (V <- m / rho_cell; mass and the cell's water volume
+  /// are kept), so the fluid's pressure is one per cell. Without it two points of a cell can
+  /// carry opposite pressures that exert no nodal force, and the storage equation feeds them:
+  /// the Terzaghi column's top cell reached +-7e5 Pa under a 1e4 Pa load. The single-point
+  /// scheme does the same with its pore pressure (the Q1-P0 element; Anura3D smooths the liquid
+  /// pressure per element too).
+  void smooth_liquid_density(Simulation<D>& sim) {
+    auto& set = sim.sets[kLiquid];
+    Particles<D>& P = set.particles;
+    const Grid<D>& grid = sim.grid;
+    cell_.assign(grid.num_cells * 2, 0.0);
+    cell_index_.resize(P.size());
+    const double* m = P.col(P.mass);
+    double* V = P.col(P.volume);
+    // A point's cell lies inside its node stencil: the scatter's colouring keeps the sums
+    // race-free.
+    set.scatter_blocks([&](size_t b, int count, int) {
+      for (size_t i = b; i < b + size_t(count); ++i) {
+        const size_t c = cell_index(grid, P, i);
+        cell_index_[i] = c;
+        cell_[2 * c] += m[i];
+        cell_[2 * c + 1] += V[i];
+      }
+    });
+    const long np = long(P.size());
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+    for (long i = 0; i < np; ++i) {
+      const size_t c = cell_index_[size_t(i)];
+      V[i] = m[i] * cell_[2 * c + 1] / cell_[2 * c];
+    }
+  }
+
+  /// The fluid's stress from its density and L_w, and the pressure field, per block.
+  void liquid_stress(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
+                     int thread) {
+    Particles<D>& P = set.particles;
+    double* L = scratch_[size_t(thread)]->L.data();
+    for (int p = 0; p < count; ++p)
+      for (int a = 0; a < D * D; ++a)
+        L[size_t(a) * kBlock + size_t(p)] = lw_[(b + size_t(p)) * D * D + size_t(a)];
+    sim.update_block_stress(set, b, count, dt, L);
+    water_pressure(P, b, b + size_t(count));
+  }
+
+  /// The pore_pressure field of liquid points [b, e): -tr(sigma_w)/3.
+  void water_pressure(Particles<D>& P, size_t b, size_t e) const {
+    for (size_t i = b; i < e; ++i) {
+      double tr = 0;
+      for (int c = 0; c < 3; ++c) tr += P.col(P.stress, c)[i];
+      P.col(p_)[i] = -tr / 3;
+    }
+  }
+
+  /// Move a point by dt v_grid, never across a held face.
+  static void move_point(const Simulation<D>& sim, Particles<D>& P, size_t i, const double* dx) {
+    for (int d = 0; d < D; ++d)
+      P.col(P.position, d)[i] = sim.held_faces.moved(d, P.col(P.position, d)[i], dx[d]);
+  }
+};
+
+LOAM_REGISTER(Scheme, TwoPhaseDoublePoint)
+
+}  // namespace loam

@@ -1,0 +1,325 @@
+// The two_phase_double_point scheme (schemes/two_phase_double_point.cpp): solid and liquid points
+// on one grid. Terzaghi's consolidation against the series and against the single-point scheme
+// on the same column (docs/verification.md C and F), the time step's independence of the
+// permeability (implicit drag), invariance under a rigid translation with every shape function,
+// the pores filled at set-up, and the located errors of its set-up.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include "cli.hpp"
+#include "framework/config.hpp"
+#include "sim_helpers.hpp"
+
+namespace {
+
+/// Max |p/p0 - exact| at each time factor from the run's terzaghi reference (verify:).
+void check_terzaghi_double_point(const std::string& config, const std::string& extra = "") {
+  // Reference: docs/verification.md C, the one-way drainage series with c_v = k M / gamma_w =
+  // 1.0194 m^2/s, H = 1 m. Target (issue 13): max |p/p0 - exact| <= 0.03 at T = 0.1, 0.2, 0.5,
+  // 1 (the pressure of the liquid points), and the degree of consolidation within 0.01.
+  loam_test::TempDir dir("dp_terzaghi");
+  auto s =
+      loam_test::run_scene(config, dir.path, "--threads 1 --set output.every_time=10 " + extra);
+  auto v = s["verify"];
+  for (const char* T : {"0.05", "0.1", "0.2", "0.5", "1"}) {
+    const double e = v[std::string("max_error_T") + T];
+    const double u = v[std::string("consolidation_degree_error_T") + T];
+    std::printf("double point %s %s, T = %-4s: max |p/p0 - exact| = %.4f, |U - U_exact| = %.2e\n",
+                config.c_str(), extra.c_str(), T, e, std::fabs(u));
+    if (std::string(T) != "0.05") CHECK(e <= 0.03);
+    CHECK(std::fabs(u) <= 0.01);
+  }
+  std::printf("%s: %ld steps, %.1f s wall\n", config.c_str(), s["steps"].get<long>(),
+              s["wall_seconds"].get<double>());
+}
+
+/// Pore pressures of a frame ordered by position along the last axis.
+std::vector<double> pressures_by_height(const std::filesystem::path& frame, int dim) {
+  const auto x = loam_test::read_frame_doubles(frame, "position");
+  const auto p = loam_test::read_frame_doubles(frame, "pore_pressure");
+  const size_t n = p.size(), stride = x.size() / n;
+  std::vector<size_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return x[a * stride + size_t(dim - 1)] < x[b * stride + size_t(dim - 1)];
+  });
+  std::vector<double> out;
+  for (size_t i : order) out.push_back(p[i]);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("double point: the Terzaghi column against the series and the single-point scheme",
+          "[verification][double_point]") {
+  check_terzaghi_double_point("terzaghi_double_point.yaml");
+  // The same column with the single-point scheme (configs/seed001_terzaghi.yaml: the same
+  // parameters, one point per volume carrying both phases): the two schemes solve the same
+  // equations, so their pore pressures at the same points (the liquid points start where the
+  // single-point particles are) agree to the discretisation differences: measured 0.0018 p0 at
+  // worst (2026-12-02), target 0.005 p0 at t = 0.1, 0.2, 0.5 and 1 s.
+  loam_test::TempDir sp("dp_vs_sp_single"), dp("dp_vs_sp_double");
+  loam_test::run_scene("seed001_terzaghi.yaml", sp.path, "--threads 1 --set output.every_time=0.1");
+  loam_test::run_scene("terzaghi_double_point.yaml", dp.path,
+                       "--threads 1 --set output.every_time=0.1");
+  for (int k : {1, 2, 5, 10}) {
+    char name[32];
+    std::snprintf(name, sizeof name, "_%06d.h5", k);
+    const auto a = pressures_by_height(sp.path / (std::string("particles") + name), 1);
+    const auto b = pressures_by_height(dp.path / (std::string("liquid") + name), 1);
+    REQUIRE(a.size() == b.size());
+    double worst = 0;
+    for (size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::fabs(a[i] - b[i]) / 1e4);
+    std::printf("double vs single point, t = %.1f s: max |p_dp - p_sp| / p0 = %.4f\n", 0.1 * k,
+                worst);
+    CHECK(worst <= 0.005);
+  }
+}
+
+TEST_CASE("double point: the Terzaghi column meets the target with every shape function",
+          "[verification][double_point]") {
+  for (const char* sf : {"gimp", "bspline2", "cpdi"})
+    check_terzaghi_double_point("terzaghi_double_point.yaml",
+                                std::string("--set shape_function=") + sf);
+}
+
+TEST_CASE("double point: the 2D Terzaghi column gives the 1D answer",
+          "[verification][double_point]") {
+  check_terzaghi_double_point("terzaghi_double_point_2d.yaml");
+}
+
+TEST_CASE("double point: the 3D Terzaghi column gives the 1D answer",
+          "[verification][double_point][full]") {
+  check_terzaghi_double_point("terzaghi_double_point_3d.yaml");
+}
+
+TEST_CASE("double point: the time step does not depend on the permeability",
+          "[double_point][mechanism]") {
+  // The drag is implicit per node (framework/two_phase_blocks.hpp), so k = 1e-3 and 1e-9 m/s
+  // (Q 6 orders of magnitude apart) run with the same time step: the CFL step of the fastest
+  // wave. Anura3D's explicit drag would need dt < 2 rho k / mu: 2e-10 s at k = 1e-9 m/s
+  // (kappa = 1e-16 m^2). The drag is applied: at t = 0.01 s (T = 0.0104) the k = 1e-3 column
+  // has drained near its top (p/p0 = erf(z' / (2 sqrt(T))) = 0.24 at the depth z' = 4.4 cm of
+  // the fourth liquid point from the top) while at k = 1e-9 it is still undrained (p/p0 = 1).
+  double dt[3];
+  double p_top[3];
+  const char* ks[3] = {"1e-3", "1e-6", "1e-9"};
+  for (int i = 0; i < 3; ++i) {
+    loam_test::TempDir dir("dp_dt");
+    auto s = loam_test::run_scene(
+        "terzaghi_double_point.yaml", dir.path,
+        std::string("--threads 1 --set time.end=0.01 --set output.every_time=0.01 "
+                    "--set verify.time_factors=[0.005] --set scheme.drag.hydraulic_conductivity=") +
+            ks[i]);
+    dt[i] = s["dt_max"];
+    const auto p = pressures_by_height(dir.path / "liquid_000001.h5", 1);
+    p_top[i] = p[p.size() - 4];
+    std::printf("k = %s m/s: dt_max = %.6e s, %ld steps, p/p0 at 4.4 cm depth %.4f\n", ks[i], dt[i],
+                s["steps"].get<long>(), p_top[i] / 1e4);
+  }
+  CHECK(dt[1] == Approx(dt[0]).epsilon(1e-3));
+  CHECK(dt[2] == Approx(dt[0]).epsilon(1e-3));
+  CHECK(p_top[0] < 0.5e4);
+  CHECK(p_top[2] > 0.9e4);
+}
+
+TEST_CASE("double point: a rigid translation of a saturated block gives no pressure or stress",
+          "[double_point][invariance]") {
+  // A block of solid and liquid points (porosity 0.4) moving at (1, -0.5) m/s, no gravity, no
+  // boundary: over 200 steps (the block crosses 1.4 cells) every velocity must stay (1, -0.5)
+  // to round-off, and no pore pressure or effective stress may appear. Tolerance 1e-6 Pa
+  // (K_w = 2e7 Pa: a spurious strain of 5e-14) and 1e-10 m/s.
+  for (const char* sf : {"linear", "gimp", "bspline2", "cpdi"}) {
+    const std::string yaml = std::string(R"(
+grid: {origin: [0, 0], extent: [2, 2], cell_size: 0.1}
+shape_function: )") + sf + R"(
+scheme: {type: two_phase_double_point, porosity: 0.4, drag: {type: darcy, hydraulic_conductivity: 1.0e-4}}
+bodies:
+  - {name: soil, set: solid, generator: {type: box, min: [0.6, 0.8], max: [1.0, 1.2]},
+     material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2650}, velocity: [1, -0.5]}
+  - {name: water, set: liquid, generator: {type: box, min: [0.6, 0.8], max: [1.0, 1.2]},
+     material: {type: newtonian_fluid, bulk_modulus: 2.0e7, viscosity: 1.0e-3, density: 1000},
+     velocity: [1, -0.5]}
+time: {end: 1, dt: 7.0e-4}
+)";
+    auto sim = loam_test::make_simulation<2>(yaml);
+    loam_test::advance(*sim, 200);
+    double dv = 0, p = 0, s = 0;
+    for (const auto& set : sim->sets) {
+      const auto& P = set.particles;
+      const int pw = P.find("pore_pressure");
+      for (size_t i = 0; i < P.size(); ++i) {
+        dv = std::max(
+            {dv, std::fabs(P.col(P.velocity, 0)[i] - 1), std::fabs(P.col(P.velocity, 1)[i] + 0.5)});
+        for (int c = 0; c < P.NS; ++c) s = std::max(s, std::fabs(P.col(P.stress, c)[i]));
+        if (P.has(pw) && set.name == "liquid") p = std::max(p, std::fabs(P.col(pw)[i]));
+      }
+    }
+    std::printf(
+        "double point %s: rigid translation max |v - v0| = %.2e m/s, |p| = %.2e Pa, "
+        "|sigma| = %.2e Pa\n",
+        sf, dv, p, s);
+    CHECK(dv < 1e-10);
+    CHECK(p < 1e-6);
+    CHECK(s < 1e-6);
+  }
+}
+
+TEST_CASE("double point: water over the same box as the soil fills only its pores",
+          "[double_point][mechanism]") {
+  // fill_pores: a liquid body generated over a soil body keeps the fraction n_c of its points'
+  // volume and mass, n_c the porosity of the point's grid cell; beside the soil it keeps its
+  // points as they are. Exact for a regular fill: water mass = n rho_w V in the soil plus
+  // rho_w V beside it (soil [0, 1] x [0, 1] at n = 0.4, water over [0, 2] x [0, 1]).
+  const std::string yaml = R"(
+grid: {origin: [0, 0], extent: [2, 1], cell_size: 0.1}
+scheme: {type: two_phase_double_point, porosity: 0.4, drag: {type: darcy, hydraulic_conductivity: 1.0e-4}}
+bodies:
+  - {name: soil, set: solid, generator: {type: box, min: [0, 0], max: [1, 1]},
+     material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2650}}
+  - {name: water, set: liquid, generator: {type: box, min: [0, 0], max: [2, 1]},
+     material: {type: newtonian_fluid, bulk_modulus: 2.0e7, viscosity: 1.0e-3, density: 1000}}
+time: {end: 1}
+)";
+  auto sim = loam_test::make_simulation<2>(yaml);
+  const auto& S = sim->sets[0].particles;
+  const auto& L = sim->sets[1].particles;
+  const int n = L.find("porosity");
+  double ms = 0, mw_soil = 0, mw_free = 0, nmin = 1, nmax = 0;
+  for (size_t i = 0; i < S.size(); ++i) ms += S.col(S.mass)[i];
+  for (size_t i = 0; i < L.size(); ++i) {
+    const bool in_soil = L.col(L.position, 0)[i] < 1;
+    (in_soil ? mw_soil : mw_free) += L.col(L.mass)[i];
+    if (in_soil) nmin = std::min(nmin, L.col(n)[i]), nmax = std::max(nmax, L.col(n)[i]);
+  }
+  std::printf(
+      "fill_pores: solid mass %.9f kg/m (exact 1590), water in the soil %.9f (exact "
+      "0.4*1000*1 = 400), beside it %.9f (exact 1000), point porosity in the soil "
+      "%.12f..%.12f\n",
+      ms, mw_soil, mw_free, nmin, nmax);
+  CHECK(ms == Approx(0.6 * 2650 * 1.0).epsilon(1e-12));
+  CHECK(mw_soil == Approx(0.4 * 1000 * 1.0).epsilon(1e-12));
+  CHECK(mw_free == Approx(1000 * 1.0).epsilon(1e-12));
+  CHECK(nmin == Approx(0.4).epsilon(1e-12));
+  CHECK(nmax == Approx(0.4).epsilon(1e-12));
+}
+
+TEST_CASE("double point: wrong materials for a set and an unknown set are located errors",
+          "[double_point][cli]") {
+  loam_test::TempDir dir("dp_bad");
+  const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/terzaghi_double_point.yaml";
+  auto r = loam_test::run_loam(
+      "run " + cfg + " --quiet --out " + dir.path.string() +
+      " --set 'bodies.0.material={type: newtonian_fluid, bulk_modulus: 2.2e9, viscosity: 0.001, "
+      "density: 1000}'" +
+      " --set 'bodies.1.material={type: linear_elastic, E: 1.0e7, nu: 0.0, density: 2650}'");
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("error: bodies.0.material: 'newtonian_fluid' is a fluid: put water in the "
+                      "liquid set") != std::string::npos);
+  CHECK(r.output.find("error: bodies.1.material: a body in the liquid set needs a fluid "
+                      "material") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir.path));
+  auto u = loam_test::run_loam("run " + cfg + " --quiet --out " + dir.path.string() +
+                               " --set bodies.1.set=water");
+  std::printf("%s", u.output.c_str());
+  CHECK(u.exit_code == 2);
+  CHECK(u.output.find("error: bodies.1.set: unknown particle set 'water'; scheme "
+                      "'two_phase_double_point' has: solid (") != std::string::npos);
+  CHECK(u.output.find("liquid (water: a fluid material") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir.path));
+}
+
+TEST_CASE("double point: hydrostatic water over a soil layer stays at rest",
+          "[verification][double_point]") {
+  // Reference: docs/verification.md F (configs/hydrostatic_double_point.yaml): 1 m of soil
+  // (n = 0.4) under water standing to 1.6 m, fixed impermeable base, started hydrostatic: water
+  // p = rho_w g (1.6 - z), effective stress sigma'_xx = -(1 - n)(rho_s - rho_w) g (1 - z).
+  // Over 1 s (~1700 transits of the undrained wave through the layer) every point of both sets
+  // must stay below 1e-6 m/s; the water pressure, one value per cell (pressure_smoothing:
+  // cell), must equal the hydrostatic value at the cell centre within 1e-3 of the base pressure
+  // (15.7 kPa); the effective stress the buoyant weight within 1e-2 of its base value.
+  loam::Diagnostics diag;
+  auto cfg = loam::load_config(
+      std::string(LOAM_SOURCE_DIR) + "/configs/hydrostatic_double_point.yaml", {}, diag);
+  REQUIRE(diag.ok());
+  loam::Simulation<1> sim(cfg.params, 1, diag);
+  REQUIRE(diag.ok());
+  double vmax = 0;
+  while (sim.time < 1.0 - 1e-12) {
+    if (!sim.advance(std::min(sim.stable_dt(), 1.0 - sim.time))) FAIL(sim.failure);
+    for (const auto& set : sim.sets)
+      for (size_t i = 0; i < set.size(); ++i)
+        vmax = std::max(vmax, std::fabs(set.particles.col(set.particles.velocity)[i]));
+  }
+  const double g = 9.81, rho_w = 1000, gamma_b = 0.6 * 1650 * g, h = 0.05;
+  const auto& L = sim.sets[1].particles;
+  const int pw = L.find("pore_pressure");
+  const double p_base = rho_w * g * 1.6;
+  double p_err = 0;
+  for (size_t i = 0; i < L.size(); ++i) {
+    const double z = L.col(L.position)[i];
+    const double zc = (std::floor(z / h) + 0.5) * h;
+    p_err = std::max(p_err, std::fabs(L.col(pw)[i] - rho_w * g * (1.6 - zc)) / p_base);
+  }
+  const auto& S = sim.sets[0].particles;
+  double s_err = 0;
+  for (size_t i = 0; i < S.size(); ++i) {
+    const double z = S.col(S.position)[i];
+    s_err = std::max(s_err, std::fabs(S.col(S.stress, 0)[i] + gamma_b * (1 - z)) / gamma_b);
+  }
+  std::printf(
+      "hydrostatic double point: max |v| over 1 s = %.2e m/s, max |p - rho_w g (1.6 - "
+      "z_cell)| / p_base = %.2e, max |sigma' - buoyant| / gamma' H = %.2e (%ld steps)\n",
+      vmax, p_err, s_err, sim.step);
+  CHECK(vmax <= 1e-6);
+  CHECK(p_err <= 1e-3);
+  CHECK(s_err <= 1e-2);
+}
+
+TEST_CASE("double point: the total energy of an undrained vibration is conserved",
+          "[double_point][energy][cli]") {
+  // Reference: the single-point scheme's test (tests/test_two_phase_mechanism.cpp) with the
+  // column as solid and liquid points: no load, no gravity, k = 1e-9 m/s (the water is locked
+  // to the skeleton: the drag's work vanishes), both phases started at 0.01 sin(pi x / 2L) m/s,
+  // fixed base, free top, 0.025 s (about 10 periods of the undrained wave). Kinetic energy of
+  // both sets + skeleton strain energy + the water's equation-of-state energy (newtonian_fluid)
+  // stays E0 = 1/2 sum m v0^2. Target 2 % (the single-point scheme: 0.9 %); the energy must
+  // swing into storage (peak stored >= 0.9 E0). This checks the storage rate's adjointness to
+  // the shared liquid stress (schemes/two_phase_double_point.cpp, step 4).
+  loam_test::TempDir dir("dp_energy");
+  const std::string yaml = R"(
+grid: {origin: [0], extent: [1.0], cell_size: 0.025}
+scheme: {type: two_phase_double_point, porosity: 0.4, drag: {type: darcy, hydraulic_conductivity: 1.0e-9}}
+bodies:
+  - {name: column, set: solid, generator: {type: box, min: [0], max: [1.0]},
+     material: {type: linear_elastic, E: 1.0e7, nu: 0.0, density: 2650},
+     velocity: {type: sine, amplitude: [0.01], wavenumber: [1.5707963267948966]}}
+  - {name: water, set: liquid, generator: {type: box, min: [0], max: [1.0]},
+     material: {type: newtonian_fluid, bulk_modulus: 2.2e9, viscosity: 0, density: 1000},
+     velocity: {type: sine, amplitude: [0.01], wavenumber: [1.5707963267948966]}}
+boundaries: [{type: fixed, face: x-}]
+time: {end: 0.025, cfl: 0.5}
+output: {every_time: 0.025, history_every: 10}
+)";
+  auto r = loam_test::run_yaml(dir.path, yaml, "--threads 1");
+  REQUIRE(r.exit_code == 0);
+  auto h = loam_test::read_csv_columns(dir.path / "out" / "history.csv");
+  const auto& total = h["total_energy"];
+  const auto& strain = h["strain_energy"];
+  REQUIRE(total.size() > 100);
+  double worst = 0, strain_max = 0;
+  for (size_t i = 0; i < total.size(); ++i) {
+    worst = std::max(worst, std::fabs(total[i] / total[0] - 1));
+    strain_max = std::max(strain_max, strain[i]);
+  }
+  std::printf(
+      "double point undrained vibration: E0 = %.6g J, max |E/E0 - 1| = %.4f over %zu "
+      "samples; peak stored energy %.4g J\n",
+      total[0], worst, total.size(), strain_max);
+  CHECK(worst <= 0.02);
+  CHECK(strain_max >= 0.9 * total[0]);
+}
