@@ -134,11 +134,16 @@ class Boundary {
   virtual void before_constraints(const GridUpdate&) {}
   /// The same before the conditions act on a single nodal vector of `phase`.
   virtual void before_constrain(const NodalVector& /*v*/, int /*phase*/) {}
-  /// The grid face (face_index) whose normal motion this condition holds for the particles, or
-  /// -1 (default: none; hydraulic conditions and faces that leave the solid's normal free).
-  /// The Simulation collects them at set-up (HeldFaces) and the schemes keep every particle on
-  /// or inside a held face, whatever the interpolated grid velocity near it.
-  virtual int holds_face() const { return -1; }
+  /// The grid face (face_index) whose normal motion this condition holds for the particles of
+  /// `phase` (0: the only phase or the solid, 1: the water), or -1 (default: none; hydraulic
+  /// conditions and faces that leave the phase's normal free). The Simulation collects them at
+  /// set-up (HeldFaces) and the schemes keep every particle on or inside a held face, whatever
+  /// the interpolated grid velocity near it.
+  virtual int holds_face(int /*phase*/) const { return -1; }
+  /// The grid face on which this (hydraulic) condition lets the water through although a
+  /// mechanical condition holds it there (drained, a prescribed pore pressure), or -1: the
+  /// water's own points (a double-point scheme's liquid set) may leave through that face.
+  virtual int releases_face() const { return -1; }
 };
 
 /// The nodes on one face of the grid ("x-", "x+", "y-", ...), for face-based plugins.
@@ -152,10 +157,12 @@ inline int face_index(const Face& f) {
   return 2 * f.axis + (f.upper ? 1 : 0);
 }
 
-/// The faces that hold the particles, as bounds per axis: lower[d] is the grid's lower
-/// coordinate along d if some condition holds face 2 d (Boundary::holds_face), else -inf;
-/// upper[d] likewise. Schemes pass every particle move through moved(). A particle leaving
-/// through an open face is left alone, for Simulation::check_particles to report (exit 3).
+/// The faces that hold the particles of one phase, as bounds per axis: lower[d] is the grid's
+/// lower coordinate along d if some condition holds face 2 d for the phase
+/// (Boundary::holds_face) and, for the water (phase 1), no condition releases it
+/// (Boundary::releases_face), else -inf; upper[d] likewise. Schemes pass every particle move
+/// through moved(). A particle leaving through an open face is left alone, for
+/// Simulation::check_particles to report (exit 3) or a sink to remove.
 template <int D>
 struct HeldFaces {
   std::array<double, D> lower, upper;
@@ -164,10 +171,14 @@ struct HeldFaces {
     upper.fill(std::numeric_limits<double>::infinity());
   }
   template <class Boundaries>
-  HeldFaces(const Grid<D>& grid, const Boundaries& boundaries) : HeldFaces() {
+  HeldFaces(const Grid<D>& grid, const Boundaries& boundaries, int phase = 0) : HeldFaces() {
     for (const auto& b : boundaries) {
-      const int f = b->holds_face();
+      const int f = b->holds_face(phase);
       if (f < 0 || f >= 2 * D) continue;
+      bool released = false;
+      for (const auto& r : boundaries)
+        released = released || (phase == 1 && r->releases_face() == f);
+      if (released) continue;
       const int d = f / 2;
       if (f % 2)
         upper[size_t(d)] = grid.upper(d);

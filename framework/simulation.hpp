@@ -69,6 +69,9 @@ class Simulation {
   /// The faces the boundary conditions hold (Boundary::holds_face), collected at set-up: schemes
   /// pass every particle move through held_faces.moved.
   HeldFaces<D> held_faces;
+  /// The faces that hold the water's own points (a double-point scheme's liquid set): those of
+  /// the conditions that hold the water phase, less the faces a drained condition releases.
+  HeldFaces<D> held_faces_water;
 
   Vec gravity{};
   double time = 0, dt = 0, end_time = 0, cfl = 0.5, fixed_dt = 0;

@@ -63,6 +63,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   if (particles_ok) scheme->initial_state(*this);
   for (auto& b : boundaries) b->setup(*this, diag);
   held_faces = HeldFaces<D>(grid, boundaries);
+  held_faces_water = HeldFaces<D>(grid, boundaries, 1);
   model_checked = true;
   if (!particles_ok) return;  // loads and references select particles
   for (auto& l : loads) l->setup(*this, diag);

@@ -648,7 +648,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         add_velocity_gradient<D>(l, remap_.data() + size_t(st.node[kp]) * 2 * D, st, size_t(k), p);
       }
-      move_point(sim, P, i, move + size_t(p) * D);
+      move_point(sim.held_faces, P, i, move + size_t(p) * D);
       store_velocity_gradient<D>(l, L, p);
       const double J = update_volume_and_deformation<D>(l, dt, P.col(P.volume)[i], F, p);
       double& n = P.col(n_)[i];
@@ -688,7 +688,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
           rate += ((1 - n_I) * vr[d] + n_I * vr[D + d]) *
                   st.grad[(size_t(k) * D + size_t(d)) * kBlock + size_t(p)];
       }
-      move_point(sim, P, i, move + size_t(p) * D);
+      move_point(sim.held_faces_water, P, i, move + size_t(p) * D);
       for (int a = 0; a < D; ++a)
         for (int c = 0; c < D; ++c) lw_[i * D * D + size_t(a * D + c)] = lw[a][c];
       if (F[0]) update_deformation_gradient<D>(F, lw, dt, p);
@@ -750,10 +750,11 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     }
   }
 
-  /// Move a point by dt v_grid, never across a held face.
-  static void move_point(const Simulation<D>& sim, Particles<D>& P, size_t i, const double* dx) {
+  /// Move a point by dt v_grid, never across a face held for its phase (the water passes a
+  /// face held for the solid only, or released by a drained condition).
+  static void move_point(const HeldFaces<D>& walls, Particles<D>& P, size_t i, const double* dx) {
     for (int d = 0; d < D; ++d)
-      P.col(P.position, d)[i] = sim.held_faces.moved(d, P.col(P.position, d)[i], dx[d]);
+      P.col(P.position, d)[i] = walls.moved(d, P.col(P.position, d)[i], dx[d]);
   }
 };
 

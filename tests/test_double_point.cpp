@@ -323,3 +323,85 @@ output: {every_time: 0.025, history_every: 10}
   CHECK(worst <= 0.02);
   CHECK(strain_max >= 0.9 * total[0]);
 }
+
+namespace {
+
+/// From the last liquid frame of a 1D permeameter run: the driving gradient gamma_w i =
+/// -(dp/dz) - rho_w g (least squares over the sample's interior, 0.1 < z < 0.9) and the flux
+/// U = mean n |w| of the liquid points there; the worst deviation of p from the fitted line.
+struct Seepage {
+  double gamma_i = 0, U = 0, scatter = 0;
+};
+Seepage seepage(const std::filesystem::path& frame) {
+  const auto x = loam_test::read_frame_doubles(frame, "position");
+  const auto p = loam_test::read_frame_doubles(frame, "pore_pressure");
+  const auto v = loam_test::read_frame_doubles(frame, "velocity");
+  const auto n = loam_test::read_frame_doubles(frame, "porosity");
+  const size_t N = p.size(), sx = x.size() / N, sv = v.size() / N;
+  double s1 = 0, sz = 0, sp = 0, szz = 0, szp = 0, su = 0;
+  for (size_t i = 0; i < N; ++i) {
+    const double z = x[i * sx];
+    if (z <= 0.1 || z >= 0.9) continue;
+    s1 += 1, sz += z, sp += p[i], szz += z * z, szp += z * p[i], su += n[i] * v[i * sv];
+  }
+  Seepage s;
+  const double slope = (s1 * szp - sz * sp) / (s1 * szz - sz * sz), icpt = (sp - slope * sz) / s1;
+  for (size_t i = 0; i < N; ++i) {
+    const double z = x[i * sx];
+    if (z > 0.1 && z < 0.9) s.scatter = std::max(s.scatter, std::fabs(p[i] - slope * z - icpt));
+  }
+  s.gamma_i = slope + 1000 * 9.81;  // downward flow: head z + p/gamma_w falls downward
+  s.U = -su / s1;
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("double point: permeameter flow rates follow Darcy and Ergun",
+          "[verification][double_point]") {
+  // Reference: docs/verification.md F (configs/permeameter_double_point.yaml): water drains from
+  // a constant-level reservoir through a 1 m sample (n = 0.4) to a free outlet; at steady state
+  // the flux U and the gradient i in the sample must satisfy Darcy, U = k i (k = 1e-3 m/s), or
+  // Ergun, gamma_w i = a U + b U^2 with a = 150 mu (1 - n)^2 / (n^3 d^2), b = 1.75 (1 - n)
+  // rho_w / (n^3 d), for d = 0.258 mm (seed 003's sand: laminar, b U^2 0.5 % of the gradient)
+  // and d = 5 mm (84 % inertial). Target 2 % (issue 13). The coarse sample is measured at
+  // t = 0.5 s: later the liquid points that entered it are spaced s/n (0.8 per cell), and the
+  // cell pressures scatter by kPa (docs/verification.md F).
+  struct Case {
+    const char* label;
+    std::string drag;
+    double end, d;
+  };
+  const Case cases[] = {
+      {"darcy k = 1e-3 m/s", "", 2.0, 0},
+      {"ergun d = 0.258 mm", "{type: ergun, grain_diameter: 2.58e-4}", 2.0, 2.58e-4},
+      {"ergun d = 5 mm", "{type: ergun, grain_diameter: 5.0e-3}", 0.5, 5.0e-3},
+  };
+  const double n = 0.4, mu = 1e-3, rho = 1000;
+  for (const auto& c : cases) {
+    loam_test::TempDir dir("dp_permeameter");
+    std::string extra = "--threads 1 --set time.end=" + std::to_string(c.end) +
+                        " --set output.every_time=" + std::to_string(c.end);
+    if (!c.drag.empty()) extra += " --set 'scheme.drag=" + c.drag + "'";
+    auto s = loam_test::run_scene("permeameter_double_point.yaml", dir.path, extra);
+    const Seepage q = seepage(dir.path / "liquid_000001.h5");
+    double U_ref;
+    if (c.d == 0) {
+      U_ref = 1e-3 * q.gamma_i / (rho * 9.81);
+    } else {
+      const double a = 150 * mu * (1 - n) * (1 - n) / (n * n * n * c.d * c.d);
+      const double b = 1.75 * (1 - n) * rho / (n * n * n * c.d);
+      U_ref = (-a + std::sqrt(a * a + 4 * b * q.gamma_i)) / (2 * b);
+    }
+    const double balance = s["mass"]["balance"].get<double>();
+    std::printf(
+        "permeameter %s at t = %.1f s: i = %.4f, U = %.5e m/s, law %.5e m/s, error "
+        "%+.2f %%, pressure scatter %.1f Pa, points created %ld, removed %ld, mass "
+        "balance %.1e kg\n",
+        c.label, c.end, q.gamma_i / (rho * 9.81), q.U, U_ref, 100 * (q.U / U_ref - 1), q.scatter,
+        s["particles_created"].get<long>(), s["particles_removed"].get<long>(), balance);
+    CHECK(std::fabs(q.U / U_ref - 1) <= 0.02);
+    CHECK(q.gamma_i / (rho * 9.81) == Approx(1.2).epsilon(0.05));  // the head drop of the setup
+    CHECK(std::fabs(balance) <= 1e-9 * s["mass"]["initial"].get<double>());
+  }
+}

@@ -96,7 +96,7 @@ class Absorbing : public Boundary<D> {
   /// The face is the edge of the modelled domain: the dashpots stand for the material beyond it,
   /// whose particles are not modelled, so the particles stay inside (a body pressed onto the
   /// face, which drifts at t / (rho c_p), piles up against it instead of leaving the grid).
-  int holds_face() const override { return face_index(face_); }
+  int holds_face(int) const override { return face_index(face_); }
 
   /// A dashpot constrains no momentum, force or re-mapped velocity: it acts in the update only.
   void constrain(const NodalVector&) const override {}

@@ -21,6 +21,7 @@ class Drained : public HydraulicFace<D> {
   }
   explicit Drained(const Params& p) : HydraulicFace<D>(p) {}
   const char* condition() const override { return name; }
+  int releases_face() const override { return face_index(this->face_); }
   void before_constraints(const GridUpdate& u) override { this->record(u); }
   void constrain_grid_update(const GridUpdate& u) const override { this->release(u); }
   void before_constrain(const NodalVector& v, int) override { this->record(v); }

@@ -32,7 +32,7 @@ class Fixed : public Boundary<D> {
       for (int d = 0; d < D; ++d) held.hold(n, d);
   }
   /// The particles move with the solid: `phase: water` leaves them free.
-  int holds_face() const override { return applies_to(0) ? face_index(face_) : -1; }
+  int holds_face(int phase) const override { return applies_to(phase) ? face_index(face_) : -1; }
 
  private:
   Params params_;

@@ -60,7 +60,7 @@ class Friction : public Boundary<D> {
   }
 
   /// Contact is unilateral: the particles may move away from the face, never through it.
-  int holds_face() const override { return face_index(face_); }
+  int holds_face(int) const override { return face_index(face_); }
 
   /// The normal velocity of every phase on the face before any condition acts: it decides the
   /// contact and sets the budget mu |v_n| even where a slip or fixed face holds v_n as well.

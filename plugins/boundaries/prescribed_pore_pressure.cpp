@@ -37,6 +37,7 @@ class PrescribedPorePressure : public HydraulicFace<D> {
   }
   explicit PrescribedPorePressure(const Params& p) : HydraulicFace<D>(p) {}
   const char* condition() const override { return name; }
+  int releases_face() const override { return face_index(this->face_); }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     HydraulicFace<D>::setup(sim, diag);

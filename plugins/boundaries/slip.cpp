@@ -52,9 +52,9 @@ class Slip : public Boundary<D> {
   }
   /// Only if the solid's normal is among the fixed directions (`directions: [y]` on x- holds a
   /// tangential component: the particles may leave through x-).
-  int holds_face() const override {
+  int holds_face(int phase) const override {
     const bool normal = std::find(fixed_.begin(), fixed_.end(), face_.axis) != fixed_.end();
-    return normal && applies_to(0) ? face_index(face_) : -1;
+    return normal && applies_to(phase) ? face_index(face_) : -1;
   }
 
  private:

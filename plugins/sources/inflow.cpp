@@ -17,6 +17,7 @@
 #include "framework/boundary.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "plugins/sources/box_lattice.hpp"
 
 namespace loam {
 
@@ -139,28 +140,9 @@ class Inflow : public Source<D> {
     return true;
   }
 
-  /// Lattice sites origin + (i + 1/2) s inside the region, and the upstream layer.
+  /// Lattice sites inside the region, and the upstream layer (box_lattice.hpp).
   void lattice(const Simulation<D>& sim) {
-    const auto& g = sim.grid;
-    std::array<long, D> i0{}, i1{};
-    for (int d = 0; d < D; ++d) {
-      const double o = g.origin[size_t(d)], s = s_[size_t(d)];
-      i0[size_t(d)] = long(std::ceil((lo_[size_t(d)] - o) / s - 0.5 - 1e-9));
-      i1[size_t(d)] = long(std::floor((hi_[size_t(d)] - o) / s - 0.5 + 1e-9));
-      if (i1[size_t(d)] < i0[size_t(d)]) return;
-    }
-    const long up = v_[size_t(axis_)] > 0 ? i0[size_t(axis_)] : i1[size_t(axis_)];
-    std::array<long, D> i = i0;
-    while (true) {
-      Vec x{};
-      for (int d = 0; d < D; ++d)
-        x[size_t(d)] = g.origin[size_t(d)] + (double(i[size_t(d)]) + 0.5) * s_[size_t(d)];
-      sites_.push_back(x);
-      if (i[size_t(axis_)] == up) upstream_.push_back(x);
-      int d = 0;
-      while (d < D && ++i[size_t(d)] > i1[size_t(d)]) i[size_t(d)] = i0[size_t(d)], ++d;
-      if (d == D) break;
-    }
+    box_lattice<D>(sim.grid, lo_, hi_, s_, axis_, v_[size_t(axis_)] < 0, sites_, upstream_);
   }
 
   /// The body's particles inside the region move at v (a velocity inlet).
