@@ -54,6 +54,14 @@
 //      point from the grid (u_s from the nodes that carry solid mass); in pure water (n = 1) it
 //      is the single-phase update.
 //      The fluid material then gives sigma_w from m/V and L_w (pressure, viscosity, cavitation).
+// Fluidisation (max_porosity: n_max, seed 003 section 2 and Anura3D): a solid point in contact
+// whose porosity reaches n_max is fluidised (`contact` 0): it carries no effective stress (the
+// material's update is overwritten with 0) and its porosity is the smoothed grid field at the
+// point, at least n_max (its volume follows, V = V_s / (1 - n), the solid volume kept); it
+// regains contact (sigma' restarting from 0) when that field is below n_max while it is
+// compressed (tr L_s < 0). No hysteresis. The nodal field counts the empty half cell beyond a
+// free surface of the soil (n_I = 0.7 there for n = 0.4), so grains settling at a free surface
+// inside the grid regain contact late or not at all: open (issue 13).
 // Time step: the CFL limit of the materials, and of the fastest wave of the drag-free two-phase
 // equations at every solid point (fast_wave_speed2 with the liquid materials' stiffest K_w);
 // no drag limit: the implicit drag leaves the time step independent of the permeability
@@ -93,14 +101,28 @@ class TwoPhaseDoublePoint : public Scheme<D> {
              "water density (one pressure per cell; removes the point-to-point pressure "
              "checkerboard); none: every liquid point keeps its own")
         .def("cell");
+    s.real("max_porosity", "-",
+           "fluidisation threshold n_max (seed 003: 0.5): a solid point whose porosity reaches "
+           "it carries no effective stress and takes the grid's porosity (at least n_max) "
+           "until the grains are compressed below it again; default: no fluidisation")
+        .above(0)
+        .below(1);
     add_flip_param(s);
+    s.check([](const Params& p, Diagnostics& d) {
+      if (p.has("max_porosity") && p.real("max_porosity") <= p.real("porosity"))
+        d.error(p.where("max_porosity"), p.path("max_porosity"),
+                "max_porosity " + format_number(p.real("max_porosity")) +
+                    " must exceed the initial porosity " + format_number(p.real("porosity")) +
+                    ": the soil would start fluidised");
+    });
     return s;
   }
   explicit TwoPhaseDoublePoint(const Params& p)
       : drag_(Registry::instance().create<Drag, D>(p.section("drag"))),
         n0_(p.real("porosity")),
         flip_(p.real("flip")),
-        smooth_(p.text("pressure_smoothing") == "cell") {}
+        smooth_(p.text("pressure_smoothing") == "cell"),
+        n_max_(p.has("max_porosity") ? p.real("max_porosity") : 2.0) {}
 
   int phases() const override { return 2; }
   std::vector<SetDeclaration> particle_sets() const override {
@@ -119,6 +141,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     p_ = sim.request_field(
         {"pore_pressure", 1, "Pa", "water pressure -tr(sigma_w)/3, compression positive", {}},
         kLiquid);
+    contact_ = sim.request_field(
+        {"contact", 1, "-", "1: the grains are in contact (effective stress), 0: fluidised", {}},
+        kSolid);
     drag_->setup(sim, diag);
     node_.assign(sim.grid.num_nodes * S, 0.0);
     solved_.assign(sim.grid.num_nodes * 2 * D, 0.0);
@@ -129,18 +154,28 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     cell_solid_.assign(sim.grid.num_cells, 0.0);
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
-    for (auto& set : sim.sets) initialize_particles(sim, set, 0, set.size());
+    initialize_particles(sim, sim.sets[kSolid], 0, sim.sets[kSolid].size());
     if (diag.ok()) fill_pores(sim);
   }
 
-  /// Solid points: porosity n0, solid mass (1 - n0) rho_s V. Liquid points: the porosity of the
-  /// grid where they are (1 before the first step: the liquid bodies start as given).
-  void initialize_particles(Simulation<D>&, ParticleSet<D>& set, size_t b, size_t e) override {
+  /// Solid points: porosity n0, solid mass (1 - n0) rho_s V, in contact. Liquid points (a
+  /// source's, during the run): like fill_pores, the fraction n_c of their volume and mass, n_c
+  /// the porosity of their cell from the last step's solid volumes (1 in pure water), so water
+  /// created inside the soil fills only its pores.
+  void initialize_particles(Simulation<D>& sim, ParticleSet<D>& set, size_t b, size_t e) override {
     auto& P = set.particles;
     const bool solid = &set == &solid_set(set);
     for (size_t i = b; i < e; ++i) {
-      P.col(n_)[i] = solid ? n0_ : 1.0;
-      if (solid) P.col(P.mass)[i] *= 1 - n0_;
+      if (solid) {
+        P.col(n_)[i] = n0_;
+        P.col(P.mass)[i] *= 1 - n0_;
+        P.col(contact_)[i] = 1;
+      } else {
+        const double n = cell_porosity(cell_index(sim.grid, P, i));
+        P.col(n_)[i] = n;
+        P.col(P.volume)[i] *= n;
+        P.col(P.mass)[i] *= n;
+      }
     }
   }
 
@@ -216,6 +251,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   std::vector<double> cell_;        // per grid cell: liquid mass and volume (pressure_smoothing)
   std::vector<size_t> cell_index_;  // each liquid point's cell
   bool smooth_ = true;
+  double n_max_;  // fluidisation threshold (2: never)
+  int contact_ = -1;
   std::vector<double> mixture_force_;  // per node (D values), while boundary forces are added
   struct Scratch : BlockScratch<D> {
     std::vector<double> Q;   // drag coefficients of the block
@@ -273,12 +310,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     for (size_t i = 0; i < solid.size(); ++i)
       cell_solid_[cell_index(sim.grid, solid, i)] +=
           (1 - solid.col(n_)[i]) * solid.col(solid.volume)[i];
-    for (size_t i = 0; i < liquid.size(); ++i) {
-      const double n = cell_porosity(cell_index(sim.grid, liquid, i));
-      liquid.col(n_)[i] = n;
-      liquid.col(liquid.volume)[i] *= n;
-      liquid.col(liquid.mass)[i] *= n;
-    }
+    initialize_particles(sim, sim.sets[kLiquid], 0, liquid.size());
   }
 
   static size_t cell_index(const Grid<D>& g, const Particles<D>& P, size_t i) {
@@ -641,21 +673,57 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     double* L = sc.L.data();
     const auto F = deformation_gradient_block(P, F_, b);
     const double* move = move_[kSolid].data() + b * D;
+    const double* g = node_.data();
+    double* contact = P.col(contact_) + b;
+    bool fluidised = false;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      double l[D][D] = {};
+      // L_s, and the smoothed (nodal) porosity field at the point, for a fluidised point.
+      double l[D][D] = {}, n_grid = 0;
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         add_velocity_gradient<D>(l, remap_.data() + size_t(st.node[kp]) * 2 * D, st, size_t(k), p);
+        n_grid += st.w[kp] * g[size_t(st.node[kp]) * S + kN];
       }
       move_point(sim.held_faces, P, i, move + size_t(p) * D);
       store_velocity_gradient<D>(l, L, p);
-      const double J = update_volume_and_deformation<D>(l, dt, P.col(P.volume)[i], F, p);
+      double& V = P.col(P.volume)[i];
       double& n = P.col(n_)[i];
-      n = 1 - (1 - n) / J;  // solid volume (1 - n) V conserved
+      const double Vs = (1 - n) * V;  // solid volume, conserved
+      const double J = update_volume_and_deformation<D>(l, dt, V, F, p);
+      if (contact[p] > 0) {
+        n = 1 - (1 - n) / J;
+        if (n >= n_max_) contact[p] = 0;
+      } else if (n_grid < n_max_ && volume_rate(l) < 0) {
+        contact[p] = 1;  // compressed below n_max: the grains touch again, sigma' from 0
+        n = n_grid;
+        V = Vs / (1 - n);
+      }
+      if (contact[p] == 0) {
+        n = std::max(n_grid, n_max_);
+        V = Vs / (1 - n);
+        fluidised = true;
+      }
       if (!(n > 0 && n < 1)) sc.bad_porosity = long(i);
     }
     sim.update_block_stress(set, b, count, dt, L);
+    if (fluidised) zero_effective_stress(P, b, count);
+  }
+
+  static double volume_rate(const double (&l)[D][D]) {
+    double tr = 0;
+    for (int d = 0; d < D; ++d) tr += l[d][d];
+    return tr;
+  }
+
+  /// Fluidised solid points of a block carry no effective stress (seed 003 section 2).
+  void zero_effective_stress(Particles<D>& P, size_t b, int count) const {
+    const double* contact = P.col(contact_) + b;
+    for (int c = 0; c < NS; ++c) {
+      double* s = P.col(P.stress, c) + b;
+      for (int p = 0; p < count; ++p)
+        if (contact[p] == 0) s[p] = 0.0;
+    }
   }
 
   /// Liquid points: L_w from the re-mapped water velocities; n, grad n, u_s and div u_s at the

@@ -405,3 +405,162 @@ TEST_CASE("double point: permeameter flow rates follow Darcy and Ergun",
     CHECK(std::fabs(balance) <= 1e-9 * s["mass"]["initial"].get<double>());
   }
 }
+
+namespace {
+
+/// configs/upward_seepage_double_point.yaml at the gradient i = ratio * i_c: the base pressure,
+/// the steady seepage state it starts in (water pressure and velocity, effective stress, or
+/// none above i_c) as --set overrides.
+std::string seepage_at(double ratio) {
+  const double gw = 9810, n = 0.4, k = 1e-3, gb = 0.6 * 1650 * 9.81, i = ratio * gb / gw;
+  const double sv = std::max(0.0, gb - i * gw);
+  auto num = [](double x) { return loam::format_number(x); };
+  auto vec3 = [&](double x) { return "[" + num(x) + ", " + num(x) + ", " + num(x) + "]"; };
+  return "--set boundaries.1.pressure=" + num(gw * (1.2 + i)) +
+         " --set bodies.0.stress.gradient=[" + num(sv) + "," + num(0.5 * sv) + "," + num(0.5 * sv) +
+         "] --set bodies.1.velocity=[" + num(k * i / n) + "]" +
+         " --set 'bodies.1.stress.gradient=" + vec3(gw * (1 + i)) + "'" +
+         " --set bodies.2.velocity=[" + num(k * i) + "]";
+}
+
+struct SandState {
+  double top = 0, vmax = 0, n_max = 0, gradient = 0;
+  long fluidised = 0;
+};
+SandState sand_state(const std::filesystem::path& dir, int frame) {
+  char name[40];
+  std::snprintf(name, sizeof name, "solid_%06d.h5", frame);
+  const auto x = loam_test::read_frame_doubles(dir / name, "position");
+  const auto v = loam_test::read_frame_doubles(dir / name, "velocity");
+  const auto n = loam_test::read_frame_doubles(dir / name, "porosity");
+  const auto c = loam_test::read_frame_doubles(dir / name, "contact");
+  SandState s;
+  const size_t N = n.size(), sx = x.size() / N, sv = v.size() / N;
+  for (size_t i = 0; i < N; ++i) {
+    s.top = std::max(s.top, x[i * sx]);
+    s.vmax = std::max(s.vmax, std::fabs(v[i * sv]));
+    s.n_max = std::max(s.n_max, n[i]);
+    if (c[i] == 0) ++s.fluidised;
+  }
+  std::snprintf(name, sizeof name, "liquid_%06d.h5", frame);
+  s.gradient = -seepage(dir / name).gamma_i / 9810;  // upward flow: -(dp/dz)/gamma_w - 1
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("double point: upward seepage heaves and fluidises the sand at the critical gradient",
+          "[verification][double_point]") {
+  // Reference: docs/verification.md D, i_c = (G_s - 1)(1 - n) = 0.99 for the column of
+  // configs/upward_seepage_double_point.yaml (started in its steady seepage state). Below i_c
+  // (0.9 and 0.95 i_c, 2 s): no heave (the top particle within 1e-4 m of its start 0.99375,
+  // grains slower than 1e-5 m/s) and no fluidised point. Above (1.05 i_c): the sand lifts off
+  // the base, whose points reach n_max = 0.5 and fluidise within 1.5 s, and the gradient
+  // through the heaving sand stays within 5 % of i_c (the seepage force carries the buoyant
+  // weight). Fluidisation therefore starts between 0.95 and 1.05 i_c: within 5 % of i_c.
+  const double ic = 0.6 * 1650 * 9.81 / 9810;
+  for (double ratio : {0.9, 0.95}) {
+    loam_test::TempDir dir("dp_seepage");
+    loam_test::run_scene("upward_seepage_double_point.yaml", dir.path,
+                         "--threads 1 " + seepage_at(ratio));
+    const SandState s = sand_state(dir.path, 4);
+    std::printf(
+        "upward seepage at %.2f i_c, t = 2 s: top %.6f m (start 0.99375), max |v_s| "
+        "%.2e m/s, max n %.4f, fluidised points %ld, gradient %.4f (i_c %.4f)\n",
+        ratio, s.top, s.vmax, s.n_max, s.fluidised, s.gradient, ic);
+    CHECK(std::fabs(s.top - 0.99375) <= 1e-4);
+    CHECK(s.vmax <= 1e-5);
+    CHECK(s.fluidised == 0);
+  }
+  loam_test::TempDir dir("dp_seepage_above");
+  loam_test::run_scene(
+      "upward_seepage_double_point.yaml", dir.path,
+      "--threads 1 --set time.end=1.5 --set output.every_time=0.25 " + seepage_at(1.05));
+  long fluidised = 0;
+  double first = -1, n_max = 0, gradient = 0;
+  for (int k = 1; k <= 6; ++k) {
+    const SandState s = sand_state(dir.path, k);
+    fluidised = std::max(fluidised, s.fluidised);
+    n_max = std::max(n_max, s.n_max);
+    if (s.fluidised > 0 && first < 0) first = 0.25 * k;
+    if (k == 4) gradient = s.gradient;
+  }
+  const SandState s = sand_state(dir.path, 6);
+  std::printf(
+      "upward seepage at 1.05 i_c: heave %.2f mm at 1.5 s, max n %.4f, at most %ld "
+      "points fluidised (first in the frame of t = %.2f s), gradient at 1 s %.4f (i_c "
+      "%.4f, %+.1f %%)\n",
+      1e3 * (s.top - 0.99375), n_max, fluidised, first, gradient, ic, 100 * (gradient / ic - 1));
+  CHECK(s.top - 0.99375 >= 1e-3);
+  CHECK(fluidised >= 1);
+  CHECK(std::fabs(gradient / ic - 1) <= 0.05);
+}
+
+TEST_CASE("double point: fluidised grains carry no stress and regain contact when compressed",
+          "[double_point][mechanism]") {
+  // The contact state of a solid point (schemes/two_phase_double_point.cpp, update_solid): a
+  // 1 m saturated sand column under gravity filling the grid to its top face, whose grains are
+  // all marked fluidised (contact 0) at the start, with local damping 0.5 on the solid. Fluidised
+  // points carry no effective stress (checked after the first step), so the column settles;
+  // compressed with its cells' porosity below n_max (0.4 < 0.5), every point regains contact
+  // (sigma' restarts from 0) and the stiffness comes back: after 0.5 s the effective stress is the
+  // buoyant weight gamma' (1 - z) within 5 % of gamma' H at every point.
+  const std::string yaml = R"(
+grid: {origin: [0], extent: [1.0], cell_size: 0.025}
+gravity: [-9.81]
+scheme: {type: two_phase_double_point, porosity: 0.4, max_porosity: 0.5,
+         drag: {type: darcy, hydraulic_conductivity: 1.0e-3}}
+damping: {type: local, alpha: 0.5}
+bodies:
+  - {name: sand, set: solid, generator: {type: box, min: [0], max: [1.0]},
+     material: {type: mohr_coulomb, E: 1.0e7, nu: 0.3, density: 2650, c: 0, phi: 30, psi: 0}}
+  - {name: water, set: liquid, generator: {type: box, min: [0], max: [1.0]},
+     material: {type: newtonian_fluid, bulk_modulus: 2.0e7, viscosity: 1.0e-3, density: 1000},
+     stress: {type: linear_profile, value: [0, 0, 0], gradient: [9810, 9810, 9810], axis: 0, origin: 1.0}}
+boundaries: [{type: fixed, face: x-}]
+time: {end: 1}
+)";
+  auto sim = loam_test::make_simulation<1>(yaml);
+  auto& P = sim->sets[0].particles;
+  const int contact = P.find("contact");
+  for (size_t i = 0; i < P.size(); ++i) P.col(contact)[i] = 0;
+  loam_test::advance(*sim, 1);
+  double s_fluid = 0;
+  long fluid_first = 0;
+  for (size_t i = 0; i < P.size(); ++i)
+    if (P.col(contact)[i] == 0) {
+      ++fluid_first;
+      for (int c = 0; c < P.NS; ++c) s_fluid = std::max(s_fluid, std::fabs(P.col(P.stress, c)[i]));
+    }
+  while (sim->time < 1.5) loam_test::advance(*sim, 1);
+  long fluid = 0;
+  double err = 0;
+  const double gb = 0.6 * 1650 * 9.81;
+  for (size_t i = 0; i < P.size(); ++i) {
+    if (P.col(contact)[i] == 0) ++fluid;
+    err = std::max(err, std::fabs(P.col(P.stress, 0)[i] + gb * (1 - P.col(P.position)[i])) / gb);
+  }
+  std::printf(
+      "fluidised column: after step 1 %ld of %zu points still fluidised, their max "
+      "|sigma'| %.1e Pa; at t = 1.5 s %ld fluidised, max |sigma'_xx - buoyant| / "
+      "gamma' H = %.4f\n",
+      fluid_first, P.size(), s_fluid, fluid, err);
+  CHECK(fluid_first > 0);
+  CHECK(s_fluid == 0.0);
+  CHECK(fluid == 0);
+  CHECK(err <= 0.05);
+}
+
+TEST_CASE("double point: max_porosity not above the initial porosity is a located error",
+          "[double_point][cli]") {
+  loam_test::TempDir dir("dp_nmax");
+  const std::string cfg =
+      std::string(LOAM_SOURCE_DIR) + "/configs/upward_seepage_double_point.yaml";
+  auto r = loam_test::run_loam("run " + cfg + " --quiet --out " + dir.path.string() +
+                               " --set scheme.max_porosity=0.35");
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find(":1:1: error: scheme.max_porosity: max_porosity 0.35 must exceed the "
+                      "initial porosity 0.4") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir.path));
+}
