@@ -40,6 +40,22 @@ std::string split_into_two_sets(std::string yaml) {
   return yaml;
 }
 
+/// The block as the solid set of the double-point scheme and a body of water over the same box
+/// in the liquid set: a saturated block with a solid and a liquid point in every place.
+std::string saturate_with_liquid_points(std::string yaml) {
+  const size_t b0 = yaml.find("  - name: block\n"), b1 = yaml.find("boundaries:");
+  if (b0 == std::string::npos || b1 == std::string::npos) return "";
+  std::string solid = yaml.substr(b0, b1 - b0), water = solid;
+  solid.replace(solid.find("name: block"), 11, "name: block\n    set: solid");
+  water.replace(water.find("name: block"), 11, "name: water\n    set: liquid");
+  const size_t m0 = water.find("material: {"), m1 = water.find('}', m0);
+  water.replace(m0, m1 - m0 + 1,
+                "material: {type: newtonian_fluid, bulk_modulus: 2.2e9, viscosity: 1.0e-3, "
+                "density: 1000}");
+  yaml.replace(b0, b1 - b0, solid + water);
+  return yaml;
+}
+
 }  // namespace
 
 std::string bench_scene(const std::string& scene, const std::string& shape,
@@ -54,6 +70,19 @@ std::string bench_scene(const std::string& scene, const std::string& shape,
       scene.compare(scene.size() - suffix.size(), suffix.size(), suffix) == 0)
     return split_into_two_sets(
         bench_scene(scene.substr(0, scene.size() - suffix.size()), shape, update));
+  // The double_point_ prefix: the block saturated with liquid points (the double-point scheme,
+  // MUSL only; a solid and a liquid point per place, so twice the particles).
+  const std::string prefix = "double_point_";
+  if (scene.rfind(prefix, 0) == 0) {
+    std::string yaml = bench_scene(scene.substr(prefix.size()), shape, update);
+    const std::string from = "scheme: {type: single_phase, update: " + update + "}";
+    const size_t k = yaml.find(from);
+    if (yaml.empty() || k == std::string::npos) return "";
+    yaml.replace(k, from.size(),
+                 "scheme: {type: two_phase_double_point, porosity: 0.4, drag: {type: darcy, "
+                 "hydraulic_conductivity: 1.0e-4}}");
+    return saturate_with_liquid_points(yaml);
+  }
   const bool two_phase = scene.rfind("two_phase_", 0) == 0;
   const std::string base = two_phase ? scene.substr(10) : scene;
   const std::string scheme =
@@ -117,7 +146,8 @@ int run_scene(const BenchOptions& opt, const std::string& scene, const std::stri
     if (yaml.empty()) {
       std::fprintf(stderr,
                    "loam: error: unknown bench scene '%s' (elastic_block_2d, elastic_block_3d, "
-                   "two_phase_elastic_block_2d, two_phase_elastic_block_3d; suffix _two_sets: "
+                   "two_phase_elastic_block_2d, two_phase_elastic_block_3d; prefix "
+                   "double_point_: the block saturated with liquid points; suffix _two_sets: "
                    "the block split over two particle sets)\n",
                    scene.c_str());
       return 2;
