@@ -1,4 +1,8 @@
 #pragma once
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
 // Reference (analytic solution) plugin interface, selected by `verify:`. It samples the run as it
 // goes and returns named error metrics, written to summary.json.
 #include <map>
@@ -19,6 +23,9 @@ class Reference {
   /// Called at the end of every step.
   virtual void sample(Simulation<D>&) {}
   virtual std::map<std::string, double> metrics(Simulation<D>&) = 0;
+  /// A time series the reference recorded (column name, values; the first column is usually
+  /// the time), or empty: written to summary.json (verify.series) and to verify.csv.
+  virtual std::vector<std::pair<std::string, std::vector<double>>> series() const { return {}; }
 };
 
 }  // namespace loam

@@ -20,6 +20,32 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+/// A reference's time series as CSV (a column per series, full precision), written under a
+/// temporary name and renamed, like summary.json.
+void write_series_csv(const std::filesystem::path& file,
+                      const std::vector<std::pair<std::string, std::vector<double>>>& series) {
+  const auto tmp = std::filesystem::path(file.string() + ".tmp");
+  {
+    std::ofstream out(tmp);
+    size_t rows = 0;
+    for (size_t c = 0; c < series.size(); ++c) {
+      out << (c ? "," : "") << series[c].first;
+      rows = std::max(rows, series[c].second.size());
+    }
+    out << "\n";
+    char buf[32];
+    for (size_t r = 0; r < rows; ++r) {
+      for (size_t c = 0; c < series.size(); ++c) {
+        const auto& v = series[c].second;
+        std::snprintf(buf, sizeof buf, "%.12g", r < v.size() ? v[r] : std::nan(""));
+        out << (c ? "," : "") << buf;
+      }
+      out << "\n";
+    }
+  }
+  std::filesystem::rename(tmp, file);
+}
+
 }  // namespace
 
 namespace detail {
@@ -207,7 +233,10 @@ RunResult Run<D>::loop() {
     nlohmann::json v = nlohmann::json::object();
     for (const auto& [k, x] : sim.reference->metrics(sim)) v[k] = x;
     v["reference"] = cfg_.params.section("verify").type();
+    const auto series = sim.reference->series();
+    for (const auto& [name, values] : series) v["series"][name] = values;
     res.summary["verify"] = v;
+    if (files && !series.empty()) write_series_csv(dir_ / "verify.csv", series);
   }
   if (!failure.empty()) {
     res.exit_code = 3;

@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <numeric>
 
 #include "cli.hpp"
@@ -563,4 +564,70 @@ TEST_CASE("double point: max_porosity not above the initial porosity is a locate
   CHECK(r.output.find(":1:1: error: scheme.max_porosity: max_porosity 0.35 must exceed the "
                       "initial porosity 0.4") != std::string::npos);
   CHECK_FALSE(std::filesystem::exists(dir.path));
+}
+
+TEST_CASE("scour_depth: a bed sinking rigidly scours at its speed, sampled every interval",
+          "[reference][unit]") {
+  // Reference (plugins/references/scour_depth.cpp): a sand block whose top is at y = 1 moving
+  // down rigidly at 0.5 m/s (no gravity, single phase): the highest particle near the axis sinks
+  // by 0.5 t, so scour_depth(t) = 0.5 t from the default bed level (that particle at the start).
+  // Tolerance 1e-9 m; one sample per 0.01 s.
+  loam_test::TempDir dir("scour_depth");
+  const std::string yaml = R"(
+grid: {origin: [0, 0], extent: [2, 2], cell_size: 0.1}
+bodies:
+  - {name: bed, generator: {type: box, min: [0.2, 0.5], max: [1.8, 1.0]},
+     material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2000}, velocity: [0, -0.5]}
+time: {end: 0.1, dt: 1.0e-3}
+output: {every_time: 0.1}
+verify: {type: scour_depth, axis: [1.0], half_width: 0.3, every: 0.01}
+)";
+  auto r = loam_test::run_yaml(dir.path, yaml, "--threads 1");
+  REQUIRE(r.exit_code == 0);
+  const auto csv = loam_test::read_csv_columns(dir.path / "out" / "verify.csv");
+  const auto& t = csv.at("time");
+  const auto& d = csv.at("scour_depth");
+  REQUIRE(t.size() == d.size());
+  double worst = 0;
+  for (size_t k = 0; k < t.size(); ++k) worst = std::max(worst, std::fabs(d[k] - 0.5 * t[k]));
+  std::printf(
+      "scour_depth: %zu samples from t = %g to %g s, max |depth - 0.5 t| = "
+      "%.2e m\n",
+      t.size(), t.front(), t.back(), worst);
+  CHECK(t.size() >= 10);
+  CHECK(t.back() == Approx(0.1));
+  CHECK(worst <= 1e-9);
+  std::ifstream js(dir.path / "out" / "summary.json");
+  const auto s = nlohmann::json::parse(js);
+  CHECK(s["verify"]["series"]["scour_depth"].size() == d.size());
+  CHECK(s["verify"]["scour_depth"].get<double>() == Approx(0.5 * 0.1).margin(1e-9));
+}
+
+TEST_CASE("seed 003 water jet 2D: the jet scours a pit that deepens through the first second",
+          "[scene][double_point]") {
+  // configs/seed003_water_jet_2d.yaml at 17 m/s (docs/verification.md E: the paper reports the
+  // pit deepening about linearly in the first second, a crater, the jet scattering). Regression
+  // of the scene as it stands: it must run to 1 s (exit 0: no NaN, no particle lost from the
+  // grid other than through the sink), keep the mass balance to round-off, and the pit must
+  // deepen after the impact (~0.25 s): depth at 0.8 s > depth at 0.4 s > 0.1 m, and > 0.3 m at
+  // 1 s. Measured 2026-12-02: 0.24 m at 0.4 s, 0.58 m at 0.8 s, 0.64 m at 1 s. The speed sweep
+  // (17 < 22 < 27 m/s) is issue 13's acceptance and not met yet (22 and 27 m/s stop early).
+  loam_test::TempDir dir("water_jet_2d");
+  auto s = loam_test::run_scene("seed003_water_jet_2d.yaml", dir.path, "--threads 2");
+  const auto csv = loam_test::read_csv_columns(dir.path / "verify.csv");
+  const auto& t = csv.at("time");
+  const auto& d = csv.at("scour_depth");
+  auto at = [&](double time) {
+    size_t k = 0;
+    while (k + 1 < t.size() && t[k] < time - 1e-3) ++k;
+    return d[k];
+  };
+  std::printf("water jet 2D, 17 m/s: scour depth");
+  for (size_t k = 0; k < t.size(); ++k) std::printf(" %.2f:%.3f", t[k], d[k]);
+  std::printf(" m; %ld steps, %.1f s wall, water points created %ld\n", s["steps"].get<long>(),
+              s["wall_seconds"].get<double>(), s["particles_created"].get<long>());
+  CHECK(at(0.4) > 0.1);
+  CHECK(at(0.8) > at(0.4));
+  CHECK(at(1.0) > 0.3);
+  CHECK(std::fabs(s["mass"]["balance"].get<double>()) <= 1e-9 * s["mass"]["final"].get<double>());
 }
