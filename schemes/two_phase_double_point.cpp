@@ -87,7 +87,10 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   static constexpr const char* name = "two_phase_double_point";
   static constexpr const char* summary =
       "soil and water as separate solid and liquid points on one grid (double-point, seed 003): "
-      "pure water, dry and saturated soil in one model; implicit nodal drag";
+      "pure water, dry and saturated soil in one model; implicit nodal drag; fluidisation at "
+      "max_porosity. Particle sets (bodies[].set): solid (the grains: an effective-stress "
+      "material, mass (1 - n) rho_s V; fields porosity, contact) and liquid (water: a fluid "
+      "material, intrinsic volume and density; fields porosity, pore_pressure)";
   static Schema schema() {
     Schema s;
     s.plugin("drag", "drag", "drag law between the liquid and the solid points (darcy, ergun)")
@@ -107,6 +110,18 @@ class TwoPhaseDoublePoint : public Scheme<D> {
            "until the grains are compressed below it again; default: no fluidisation")
         .above(0)
         .below(1);
+    s.real("free_surface_filling", "-",
+           "a cell whose pores the water fills less than this fraction is at the free surface: "
+           "its liquid points get the free_surface flag (0: no detection)")
+        .def("0.9")
+        .min(0)
+        .max(1);
+    s.choice("free_surface_pressure", {"free", "zero"},
+             "free: the flagged points keep the pressure of their density; zero: they are set to "
+             "zero pressure (V = m / rho_0), as Anura3D does. zero needs the cells below the "
+             "surface full of liquid points: water that has spread out inside the soil (points "
+             "s/n apart) fills its cells less and would lose its pressure there")
+        .def("free");
     add_flip_param(s);
     s.check([](const Params& p, Diagnostics& d) {
       if (p.has("max_porosity") && p.real("max_porosity") <= p.real("porosity"))
@@ -122,7 +137,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         n0_(p.real("porosity")),
         flip_(p.real("flip")),
         smooth_(p.text("pressure_smoothing") == "cell"),
-        n_max_(p.has("max_porosity") ? p.real("max_porosity") : 2.0) {}
+        n_max_(p.has("max_porosity") ? p.real("max_porosity") : 2.0),
+        free_filling_(p.real("free_surface_filling")),
+        zero_surface_pressure_(p.text("free_surface_pressure") == "zero") {}
 
   int phases() const override { return 2; }
   std::vector<SetDeclaration> particle_sets() const override {
@@ -144,6 +161,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     contact_ = sim.request_field(
         {"contact", 1, "-", "1: the grains are in contact (effective stress), 0: fluidised", {}},
         kSolid);
+    free_surface_ = sim.request_field(
+        {"free_surface", 1, "-", "1: in a cell the water fills less than free_surface_filling", {}},
+        kLiquid);
     drag_->setup(sim, diag);
     node_.assign(sim.grid.num_nodes * S, 0.0);
     solved_.assign(sim.grid.num_nodes * 2 * D, 0.0);
@@ -254,7 +274,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   std::vector<size_t> cell_index_;  // each liquid point's cell
   bool smooth_ = true;
   double n_max_;  // fluidisation threshold (2: never)
-  int contact_ = -1;
+  int contact_ = -1, free_surface_ = -1;
+  double free_filling_;  // free-surface threshold of a cell's pore filling (0: none)
+  bool zero_surface_pressure_;
   std::vector<double> mixture_force_;  // per node (D values), while boundary forces are added
   struct Scratch : BlockScratch<D> {
     std::vector<double> Q;   // drag coefficients of the block
@@ -390,7 +412,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       });
     });
     auto& liquid = sim.sets[kLiquid];
-    if (smooth_) sim.timed("pore_pressure", [&] { smooth_liquid_density(sim); });
+    sim.timed("pore_pressure", [&] { liquid_cells(sim); });
     sim.timed("g2p_gradient_stress", [&] {
       liquid.gather_blocks(
           [&](size_t b, int c, int t) { liquid_stress(sim, liquid, dt, b, c, t); });
@@ -794,14 +816,23 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     }
   }
 
-  /// pressure_smoothing: cell: every liquid point of a grid cell (at x^{n+1}) takes the cell's
-  /// mean water density, sum m / sum V (V <- m / rho_cell; mass and the cell's water volume
-  /// are kept), so the fluid's pressure is one per cell. Without it two points of a cell can
-  /// carry opposite pressures that exert no nodal force, and the storage equation feeds them:
-  /// the Terzaghi column's top cell reached +-7e5 Pa under a 1e4 Pa load. The single-point
-  /// scheme does the same with its pore pressure (the Q1-P0 element; Anura3D smooths the liquid
-  /// pressure per element too).
-  void smooth_liquid_density(Simulation<D>& sim) {
+  /// After the move, per grid cell: the liquid points' mass and volume sums, then
+  /// - pressure_smoothing: cell: every liquid point of a cell takes the cell's mean water
+  ///   density, sum m / sum V (V <- m / rho_cell; mass and the cell's water volume are kept), so
+  ///   the fluid's pressure is one per cell. Without it two points of a cell can carry opposite
+  ///   pressures that exert no nodal force, and the storage equation feeds them: the Terzaghi
+  ///   column's top cell reached +-7e5 Pa under a 1e4 Pa load. The single-point scheme does the
+  ///   same with its pore pressure (the Q1-P0 element; Anura3D smooths the liquid pressure per
+  ///   element too).
+  /// - free surface: a cell whose pores the water fills less than free_surface_filling (its
+  ///   volume sum V over n_c V_c, n_c the cell's porosity from the solid points) is at the free
+  ///   surface; its liquid points get the flag and, with free_surface_pressure: zero, zero
+  ///   pressure (V <- m / rho_0, rho_0 their material's reference density), as Anura3D does.
+  ///   Not the default: in the coarse permeameter the pore water spreads out to s/n inside the
+  ///   sample, its cells fill less than 0.9, and zero pressure there put Ergun's flux off by
+  ///   6.8 % (docs/verification.md F). The weakly compressible water needs no help at a free
+  ///   surface: its pressure follows its own density there too.
+  void liquid_cells(Simulation<D>& sim) {
     auto& set = sim.sets[kLiquid];
     Particles<D>& P = set.particles;
     const Grid<D>& grid = sim.grid;
@@ -820,10 +851,17 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       }
     });
     const long np = long(P.size());
+    double* flag = P.col(free_surface_);
+    const double filling = free_filling_;
 #pragma omp parallel for schedule(static) num_threads(sim.threads)
     for (long i = 0; i < np; ++i) {
       const size_t c = cell_index_[size_t(i)];
-      V[i] = m[i] * cell_[2 * c + 1] / cell_[2 * c];
+      const bool surface = cell_[2 * c + 1] < filling * cell_porosity(c) / inv_cell_volume_;
+      flag[i] = surface ? 1.0 : 0.0;
+      if (surface && zero_surface_pressure_)
+        V[i] = m[i] / sim.materials[P.material[size_t(i)]]->density();
+      else if (smooth_)
+        V[i] = m[i] * cell_[2 * c + 1] / cell_[2 * c];
     }
   }
 

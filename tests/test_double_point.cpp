@@ -697,3 +697,46 @@ TEST_CASE("seed 003 water jet 3D: a faster jet scours deeper at 1 s (17 then 22 
           1e-9 * s.summary["mass"]["final"].get<double>());
   }
 }
+
+TEST_CASE("double point: the free surface is flagged where the water fills a cell partly",
+          "[double_point][mechanism]") {
+  // A 1D pool of liquid points (no soil, gravity) whose surface at 0.5375 m lies inside the
+  // cell [0.5, 0.55]: that cell is filled to 0.75 < free_surface_filling 0.9, so its points (and
+  // only they) carry free_surface = 1 after a step; with free_surface_pressure: zero their
+  // pressure is 0, with the default (free) it is their density's.
+  const std::string yaml = R"(
+grid: {origin: [0], extent: [1.0], cell_size: 0.05}
+gravity: [-9.81]
+bodies:
+  - {name: water, set: liquid, generator: {type: box, min: [0], max: [0.5375]}, particles_per_cell: 4,
+     material: {type: newtonian_fluid, bulk_modulus: 2.0e7, viscosity: 1.0e-3, density: 1000},
+     stress: {type: linear_profile, value: [0, 0, 0], gradient: [9810, 9810, 9810], axis: 0, origin: 0.5375}}
+boundaries: [{type: fixed, face: x-}]
+time: {end: 1}
+)";
+  for (const char* mode : {"free", "zero"}) {
+    auto sim = loam_test::make_simulation<1>(
+        yaml + "scheme: {type: two_phase_double_point, porosity: 0.4, free_surface_pressure: " +
+        std::string(mode) + ", drag: {type: darcy, hydraulic_conductivity: 1.0e-3}}\n");
+    loam_test::advance(*sim, 1);
+    const auto& P = sim->sets[1].particles;
+    const int flag = P.find("free_surface"), pw = P.find("pore_pressure");
+    long wrong = 0, flagged = 0;
+    double p_surface = 0;
+    for (size_t i = 0; i < P.size(); ++i) {
+      const bool top = P.col(P.position)[i] > 0.5;
+      if ((P.col(flag)[i] == 1) != top) ++wrong;
+      if (top) ++flagged, p_surface = std::max(p_surface, std::fabs(P.col(pw)[i]));
+    }
+    std::printf(
+        "free surface (%s): %ld points in the top cell, %ld flags wrong, max |p| there "
+        "%.3g Pa\n",
+        mode, flagged, wrong, p_surface);
+    CHECK(flagged == 3);
+    CHECK(wrong == 0);
+    if (std::string(mode) == "zero")
+      CHECK(p_surface < 1e-6);  // zero up to the round-off of m / (m / rho_0)
+    else
+      CHECK(p_surface > 10.0);  // rho g depth of the top cell's points ~ 120 Pa
+  }
+}
