@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "force_inline.hpp"
+#include "simulation.hpp"
 
 namespace loam {
 
@@ -69,6 +70,26 @@ inline double fast_wave_speed2(double M, double n, double rho_d, double Kw, doub
   const double R11 = rho_d, R22 = n * rho_w;
   const double a = R11 * R22, b = K11 * R22 + K22 * R11, c0 = M * n * Kw;
   return (b + std::sqrt(std::max(0.0, b * b - 4 * a * c0))) / (2 * a);
+}
+
+/// The largest fast_wave_speed2 over the points of a set whose `mass` is the solid mass
+/// (1 - n) rho_s V and `porosity` their porosity field, with each material's constrained modulus
+/// from its P-wave speed (M = c^2 rho_d), for pore water (K_w, rho_w); 0 for an empty set.
+template <int D>
+double max_fast_wave_speed2(const Simulation<D>& sim, const ParticleSet<D>& set, int porosity,
+                            double Kw, double rho_w) {
+  const auto& P = set.particles;
+  double c2 = 0;
+  for (size_t m = 0; m < sim.materials.size(); ++m) {
+    const auto& r = set.partition.material_ranges[m];
+    if (r.end <= r.begin) continue;
+    const double cd = sim.materials[m]->wave_speed(P, r.begin, r.end);
+    for (size_t i = r.begin; i < r.end; ++i) {
+      const double rho_d = P.col(P.mass)[i] / P.col(P.volume)[i];  // (1 - n) rho_s
+      c2 = std::max(c2, fast_wave_speed2(cd * cd * rho_d, P.col(porosity)[i], rho_d, Kw, rho_w));
+    }
+  }
+  return c2;
 }
 
 }  // namespace loam

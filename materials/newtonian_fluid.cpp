@@ -84,7 +84,8 @@ class NewtonianFluid : public Material<D> {
     for (size_t i = b; i < e; ++i) {
       double p = 0;
       for (int c = 0; c < 3; ++c) p -= P.col(P.stress, c)[i] / 3;
-      if (p != 0) V[i] = m[i] / (rho0_ * (1 + p / K_));
+      p = std::max(p, p_min_);  // no more tension than the fluid carries
+      if (p != 0 && 1 + p / K_ > 0) V[i] = m[i] / (rho0_ * (1 + p / K_));
     }
   }
 

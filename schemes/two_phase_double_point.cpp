@@ -49,10 +49,12 @@
 //      material's sigma' (Jaumann rate), one call per block. Liquid: the intrinsic density
 //      from both mass balances (seed 003 eq. 12, with its sign: compression raises rho_w),
 //        -(1/rho_w) D rho_w/Dt = div u_w + ((1 - n)/n) div u_s + (1/n) grad n . (u_w - u_s),
-//      i.e. V <- det(I + L_w dt) V (1 + dt [((1 - n)/n) div u_s + (1/n) grad n . (u_w - u_s)])
-//      with n = n_c its cell's porosity and grad n, u_s and div u_s interpolated at the liquid
-//      point from the grid (u_s from the nodes that carry solid mass); in pure water (n = 1) it
-//      is the single-phase update.
+//      which is (1/n) [div((1 - n) u_s) + div(n u_w)]. Discretised with the nodal products,
+//        V <- V (1 + dt (1/n) sum_I [(1 - n_I) v_I + n_I w_I] . grad N_I)
+//      (v_I, w_I the re-mapped velocities): the adjoint of the shared liquid stress, so the
+//      pressure work balances the stored energy (the interpolated form of eq. 12 drifted unstable
+//      under gravity); n the liquid point's porosity of the step (liquid_porosity). In pure water
+//      it is V (1 + dt tr L_w), the single-phase update to O(dt^2).
 //      The fluid material then gives sigma_w from m/V and L_w (pressure, viscosity, cavitation).
 // Fluidisation (max_porosity: n_max, seed 003 section 2 and Anura3D): a solid point in contact
 // whose porosity reaches n_max is fluidised (`contact` 0): it carries no effective stress (the
@@ -205,29 +207,18 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   }
 
   double stable_dt(const Simulation<D>& sim) const override {
-    // The stiffest water of the run and its density, from the liquid materials' wave speeds.
+    // The fast wave of the drag-free phases with each liquid material's own water (K_w =
+    // rho_w c^2 from its wave speed); dry: the materials' CFL alone.
     const auto& L = sim.sets[kLiquid];
-    double Kw = 0, rho_w = 0;
+    double c2 = 0;
     for (size_t m = 0; m < sim.materials.size(); ++m) {
       const auto& r = L.partition.material_ranges[m];
       if (r.end <= r.begin) continue;
       const double c = sim.materials[m]->wave_speed(L.particles, r.begin, r.end);
       const double rho = sim.materials[m]->density();
-      Kw = std::max(Kw, rho * c * c);
-      rho_w = std::max(rho_w, rho);
+      c2 = std::max(c2, max_fast_wave_speed2(sim, sim.sets[kSolid], n_, rho * c * c, rho));
     }
-    if (!(Kw > 0)) return std::numeric_limits<double>::infinity();  // dry: the materials' CFL
-    const auto& P = sim.sets[kSolid].particles;
-    double c2 = 0;
-    for (size_t m = 0; m < sim.materials.size(); ++m) {
-      const auto& r = sim.sets[kSolid].partition.material_ranges[m];
-      if (r.end <= r.begin) continue;
-      const double cd = sim.materials[m]->wave_speed(P, r.begin, r.end);
-      for (size_t i = r.begin; i < r.end; ++i) {
-        const double rho_d = P.col(P.mass)[i] / P.col(P.volume)[i];  // (1 - n) rho_s
-        c2 = std::max(c2, fast_wave_speed2(cd * cd * rho_d, P.col(n_)[i], rho_d, Kw, rho_w));
-      }
-    }
+    if (!(c2 > 0)) return std::numeric_limits<double>::infinity();
     return sim.cfl * sim.grid.min_cell() / (std::sqrt(c2) + sim.max_speed);
   }
 
@@ -261,11 +252,11 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   double n0_, flip_;
   int n_ = -1, p_ = -1, F_ = -1;
   std::vector<double> node_;
-  std::vector<double> vol_;         // per node: V_I = int N_I dOmega
-  std::vector<double> solved_;      // per node: v', w' of the coupled solve (2 D values)
-  std::vector<double> remap_;       // per node: re-mapped solid then water velocity (2 D values)
-  std::vector<double> move_[2];     // per set and particle: dt v_grid from the re-map pass
-  std::vector<double> cell_solid_;  // per grid cell: solid volume sum (1 - n) V of the step
+  std::vector<double> vol_;          // per node: V_I = int N_I dOmega
+  std::vector<double> solved_;       // per node: v', w' of the coupled solve (2 D values)
+  std::vector<double> remap_;        // per node: re-mapped solid then water velocity (2 D values)
+  std::vector<double> move_[2];      // per set and particle: dt v_grid from the re-map pass
+  std::vector<double> cell_solid_;   // per grid cell: solid volume sum (1 - n) V of the step
   std::vector<double> cell_liquid_;  // per grid cell: liquid volume sum V at the step's start
   std::vector<size_t> liquid_cell_;  // per liquid point: its cell at the step's start
   double inv_cell_volume_ = 1;
@@ -281,6 +272,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   struct Scratch : BlockScratch<D> {
     std::vector<double> Q;   // drag coefficients of the block
     long bad_porosity = -1;  // a solid point whose porosity left (0, 1) this step
+    long bad_volume = -1;    // a liquid point compressed to zero volume this step
   };
   std::vector<std::unique_ptr<Scratch>> scratch_;
 
@@ -329,7 +321,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   void fill_pores(Simulation<D>& sim) {
     auto& solid = sim.sets[kSolid].particles;
     auto& liquid = sim.sets[kLiquid].particles;
-    if (liquid.size() == 0) return;
+    // Also without liquid bodies: the sources at t = 0 re-mass their points with it.
     cell_solid_.assign(sim.grid.num_cells, 0.0);
     for (size_t i = 0; i < solid.size(); ++i)
       cell_solid_[cell_index(sim.grid, solid, i)] +=
@@ -365,16 +357,30 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   /// cell (liquid_cell_, indexed by point). A point's cell lies in its stencil: the scatter's
   /// colouring keeps the sums race-free.
   void liquid_cell_volumes(Simulation<D>& sim) {
+    liquid_cell_sums(sim, liquid_cell_, cell_liquid_, false);
+  }
+  /// Per grid cell the liquid points' volume sum (with_mass: mass then volume, 2 values) and
+  /// each point's cell. The sums are atomic: after a move two points of same-coloured slabs may
+  /// share a cell (one thread: the scatter's order, deterministic).
+  void liquid_cell_sums(Simulation<D>& sim, std::vector<size_t>& index, std::vector<double>& sums,
+                        bool with_mass) const {
     auto& set = sim.sets[kLiquid];
     const Particles<D>& P = set.particles;
-    cell_liquid_.assign(sim.grid.num_cells, 0.0);
-    liquid_cell_.resize(P.size());
+    const size_t stride = with_mass ? 2 : 1;
+    sums.assign(sim.grid.num_cells * stride, 0.0);
+    index.resize(P.size());
+    const double* m = P.col(P.mass);
     const double* V = P.col(P.volume);
     set.scatter_blocks([&](size_t b, int count, int) {
       for (size_t i = b; i < b + size_t(count); ++i) {
         const size_t c = cell_index(sim.grid, P, i);
-        liquid_cell_[i] = c;
-        cell_liquid_[c] += V[i];
+        index[i] = c;
+        if (with_mass) {
+#pragma omp atomic
+          sums[2 * c] += m[i];
+        }
+#pragma omp atomic
+        sums[stride * c + stride - 1] += V[i];
       }
     });
   }
@@ -431,6 +437,14 @@ class TwoPhaseDoublePoint : public Scheme<D> {
                       ": porosity left (0, 1) (n = " + format_number(P.col(n_)[i]) +
                       "); the skeleton was compressed to zero pore volume or torn apart";
         s->bad_porosity = -1;
+      }
+    for (auto& s : scratch_)
+      if (s->bad_volume >= 0) {
+        const auto& P = sim.sets[kLiquid].particles;
+        sim.failure = "liquid particle " + std::to_string(P.id[size_t(s->bad_volume)]) +
+                      ": compressed to zero volume in one step (storage rate x dt <= -1); a "
+                      "smaller time.cfl or a softer water (bulk_modulus)";
+        s->bad_volume = -1;
       }
   }
 
@@ -748,7 +762,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         if (n >= n_max_) contact[p] = 0;
       } else if (n_grid < n_max_ && volume_rate(l) < 0) {
         contact[p] = 1;  // compressed below n_max: the grains touch again, sigma' from 0
-        n = n_grid;
+        // Not denser than the initial packing: where points crowd the nodal field dips towards
+        // 0, and a grain at near-zero porosity is crushed to a negative one by the next step.
+        n = std::max(n_grid, n0_);
         V = Vs / (1 - n);
       }
       if (contact[p] == 0) {
@@ -812,7 +828,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       for (int a = 0; a < D; ++a)
         for (int c = 0; c < D; ++c) lw_[i * D * D + size_t(a * D + c)] = lw[a][c];
       if (F[0]) update_deformation_gradient<D>(F, lw, dt, p);
-      P.col(P.volume)[i] *= 1 + dt * rate / P.col(n_)[i];  // n_c: its cell's, from the scatter
+      const double factor = 1 + dt * rate / P.col(n_)[i];  // n: the step's, from the scatter
+      P.col(P.volume)[i] *= factor;
+      if (!(factor > 0)) sc.bad_volume = long(i);
     }
   }
 
@@ -833,23 +851,10 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   ///   6.8 % (docs/verification.md F). The weakly compressible water needs no help at a free
   ///   surface: its pressure follows its own density there too.
   void liquid_cells(Simulation<D>& sim) {
-    auto& set = sim.sets[kLiquid];
-    Particles<D>& P = set.particles;
-    const Grid<D>& grid = sim.grid;
-    cell_.assign(grid.num_cells * 2, 0.0);
-    cell_index_.resize(P.size());
+    Particles<D>& P = sim.sets[kLiquid].particles;
+    liquid_cell_sums(sim, cell_index_, cell_, true);
     const double* m = P.col(P.mass);
     double* V = P.col(P.volume);
-    // A point's cell lies inside its node stencil: the scatter's colouring keeps the sums
-    // race-free.
-    set.scatter_blocks([&](size_t b, int count, int) {
-      for (size_t i = b; i < b + size_t(count); ++i) {
-        const size_t c = cell_index(grid, P, i);
-        cell_index_[i] = c;
-        cell_[2 * c] += m[i];
-        cell_[2 * c + 1] += V[i];
-      }
-    });
     const long np = long(P.size());
     double* flag = P.col(free_surface_);
     const double filling = free_filling_;

@@ -142,17 +142,9 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   }
 
   double stable_dt(const Simulation<D>& sim) const override {
-    const auto& P = sim.sets[0].particles;
-    double c2 = Kw_ / rho_w_;  // a water-only region: the water wave
-    for (size_t m = 0; m < sim.materials.size(); ++m) {
-      const auto& r = sim.sets[0].partition.material_ranges[m];
-      if (r.end <= r.begin) continue;
-      const double cd = sim.materials[m]->wave_speed(P, r.begin, r.end);
-      for (size_t i = r.begin; i < r.end; ++i) {
-        const double rho_d = P.col(P.mass)[i] / P.col(P.volume)[i];  // (1 - n) rho_s
-        c2 = std::max(c2, fast_wave_speed2(cd * cd * rho_d, P.col(n_)[i], rho_d, Kw_, rho_w_));
-      }
-    }
+    // A water-only region: the water wave; the mixture: the fast wave of the drag-free phases.
+    const double c2 =
+        std::max(Kw_ / rho_w_, max_fast_wave_speed2(sim, sim.sets[0], n_, Kw_, rho_w_));
     return sim.cfl * sim.grid.min_cell() / (std::sqrt(c2) + sim.max_speed);
   }
 
@@ -288,15 +280,17 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       return c;
     };
     std::fill(cell_.begin(), cell_.end(), 0.0);
-    // A particle's cell lies inside its node stencil, so the race-free colouring of the
-    // scatter covers the cell sums too.
+    // The particles have moved since the partition was coloured: two of same-coloured slabs
+    // may now share a cell, so the sums are atomic (one thread: the same order as before).
     cell_index_.resize(P.size());
     sim.scatter_blocks([&](ParticleSet<D>&, size_t b, int count, int) {
       for (size_t i = b; i < b + size_t(count); ++i) {
         const size_t c = cell_of(i);
         cell_index_[i] = c;
         const double V = P.col(P.volume)[i];
+#pragma omp atomic
         cell_[2 * c] += V * (p[i] + dp_[i]);
+#pragma omp atomic
         cell_[2 * c + 1] += V;
       }
     });

@@ -48,10 +48,12 @@ class ScourDepth : public Reference<D> {
         every_(p.real("every")) {}
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    if (int(axis_.size()) != D - 1)
+    if (int(axis_.size()) != D - 1) {
       diag.error(params_.where("axis"), params_.path("axis"),
                  "give " + std::to_string(D - 1) + " coordinate(s): the horizontal axes of a " +
                      std::to_string(D) + "D run");
+      return;
+    }
     body_ = sim.body_param(params_, "body", diag);
     if (body_ < 0) return;
     contact_ = sim.particles_of_body(body_).find("contact");
