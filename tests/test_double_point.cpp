@@ -816,9 +816,9 @@ TEST_CASE("double point: liquid points alone collapse like Martin and Moyce's wa
   // Reference: Martin & Moyce (1952), Phil. Trans. R. Soc. Lond. A 244, 312-324, Fig. 3, n^2 =
   // 2, a = 2.25 in: surge front Z = x_f / a against T = t sqrt(2 g / a) (values as digitised in
   // PySPH's db_exp_data.py). configs/dam_break_double_point.yaml: a = 0.1 m, liquid points only.
-  // The model's front leads the experiment, whose dam was removed in a finite time: measured
+  // The model's front leads the experiment (likely its instantaneous release): measured
   // +11.0 % to +18.3 % at 0.005 m cells, +10.8 % to +18.4 % at 0.0025 m (2026-12-02: converged,
-  // so the lead is the model's instantaneous release, not resolution). Regression bound: the
+  // so the lead is not a resolution effect). Regression bound: the
   // front ahead of every data point by less than 20 %.
   const double mm[][2] = {{0.832, 1.217}, {1.219, 1.474}, {1.997, 2.292},
                           {2.547, 2.995}, {3.345, 4.134}, {4.034, 4.944}};
