@@ -336,3 +336,33 @@ TEST_CASE("newtonian_fluid: bad parameters give the located error", "[material][
   };
   loam_test::check_bad_material("type: newtonian_fluid, density: 1000, ", cases, "water");
 }
+
+TEST_CASE(
+    "newtonian_fluid: suspension viscosity mu (1 + 2.5 c + 5.2 c^2) where grains share "
+    "the water's place",
+    "[material][unit]") {
+  // Reference: materials/newtonian_fluid.cpp (docs/verification.md F). Simple shear at
+  // gamma_dot = 10 /s in 2D plane strain (harness): sigma_xy = mu_eff gamma_dot. A particle whose
+  // porosity field is 0.6 (solid concentration c = 0.4) with suspension_viscosity: true has
+  // mu_eff = mu (1 + 1.0 + 0.832) = 2.832 mu; without the field (a single-phase run) and with the
+  // option off, mu. Tolerance 1e-12 relative.
+  auto shear = [](const std::string& extra, bool porosity_field) {
+    Point<2> p(fluid(0.5, extra));
+    if (porosity_field) {
+      const int h = p.sim->request_field({"porosity", 1, "-", "test", {}});
+      p.field(h) = 0.6;
+    }
+    p.step({0, 10.0, 0, 0}, 1e-4);
+    return p.stress(3) / (0.5 * 10.0);
+  };
+  const double with = shear(", suspension_viscosity: true", true);
+  const double none = shear(", suspension_viscosity: true", false);
+  const double off = shear("", true);
+  std::printf(
+      "suspension viscosity: mu_eff / mu = %.15g (c = 0.4, exact 2.832), %.15g without a "
+      "porosity field, %.15g with the option off\n",
+      with, none, off);
+  CHECK(with == Approx(2.832).epsilon(1e-12));
+  CHECK(none == Approx(1.0).epsilon(1e-12));
+  CHECK(off == Approx(1.0).epsilon(1e-12));
+}
