@@ -9,6 +9,7 @@
 
 #include "force_inline.hpp"
 #include "simulation.hpp"
+#include "step_blocks.hpp"
 
 namespace loam {
 
@@ -54,6 +55,32 @@ LOAM_FORCE_INLINE void follow_held_phase(double ms, double mw, double Q, double 
     v += c;
     a_s += c / dt;
   }
+}
+
+/// Where a two-phase scheme's node record keeps what the grid passes below read: offsets of the
+/// solid and water masses, the drag coefficient Q, the solid and water velocities and
+/// accelerations (D values each), and the record's length.
+struct TwoPhaseRecord {
+  int solid_mass, water_mass, drag, solid_velocity, water_velocity, solid_acceleration,
+      water_acceleration, stride;
+};
+
+/// follow_held_phase at every node with both phases and drag, component by component, after the
+/// boundary conditions; `solved` holds the velocities of the coupled solve (solid then water,
+/// 2 D values per node).
+template <int D>
+void follow_held_phases(double* records, const TwoPhaseRecord& k, const double* solved,
+                        size_t num_nodes, int threads, double mass_tolerance, double dt) {
+  for_each_node(num_nodes, threads, [=](size_t i) {
+    double* r = records + i * size_t(k.stride);
+    const double* s = solved + i * 2 * D;
+    const double ms = r[k.solid_mass], mw = r[k.water_mass], Q = r[k.drag];
+    if (ms <= mass_tolerance || mw <= mass_tolerance || !(Q > 0)) return;
+    for (int d = 0; d < D; ++d)
+      follow_held_phase(ms, mw, Q, dt, s[d], s[D + d], r[k.solid_velocity + d],
+                        r[k.water_velocity + d], r[k.solid_acceleration + d],
+                        r[k.water_acceleration + d]);
+  });
 }
 
 /// Square of the fastest wave speed of the undamped (drag-free) two-phase equations: the largest

@@ -452,15 +452,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
 
   /// A phase held by a condition drags its free partner (framework/two_phase_blocks.hpp).
   void follow_held_phase(Simulation<D>& sim, double dt) {
-    const double tol = sim.mass_tolerance;
-    for_each_record(sim, [&](double* r, size_t i) {
-      const double* solved = solved_.data() + i * 2 * D;
-      const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
-      if (ms <= tol || mw <= tol || !(Q > 0)) return;
-      for (int d = 0; d < D; ++d)
-        loam::follow_held_phase(ms, mw, Q, dt, solved[d], solved[D + d], r[kV + d], r[kW + d],
-                                r[kF + d], r[kFw + d]);
-    });
+    follow_held_phases<D>(node_.data(), {kMs, kMw, kQ, kV, kW, kF, kFw, S}, solved_.data(),
+                          sim.grid.num_nodes, sim.threads, sim.mass_tolerance, dt);
   }
 
   /// MUSL first pass: FLIP/PIC update of both particle velocities and the scatter of their new
