@@ -59,10 +59,10 @@ LOAM_FORCE_INLINE void follow_held_phase(double ms, double mw, double Q, double 
 
 /// Where a two-phase scheme's node record keeps what the grid passes below read: offsets of the
 /// solid and water masses, the drag coefficient Q, the solid and water velocities and
-/// accelerations (D values each), and the record's length.
+/// accelerations (D values each), the nodal porosity, and the record's length.
 struct TwoPhaseRecord {
   int solid_mass, water_mass, drag, solid_velocity, water_velocity, solid_acceleration,
-      water_acceleration, stride;
+      water_acceleration, porosity, stride;
 };
 
 /// follow_held_phase at every node with both phases and drag, component by component, after the
@@ -81,6 +81,28 @@ void follow_held_phases(double* records, const TwoPhaseRecord& k, const double* 
                         r[k.water_velocity + d], r[k.solid_acceleration + d],
                         r[k.water_acceleration + d]);
   });
+}
+
+/// The boundary conditions on both phases of the records after the coupled solve
+/// (Simulation::constrain_update, with the nodal masses and porosity), then the re-solve of a
+/// free phase against a held partner (follow_held_phases).
+template <int D>
+void constrain_two_phase_update(Simulation<D>& sim, double* records, const TwoPhaseRecord& k,
+                                const double* solved, double dt) {
+  GridUpdate u;
+  const int S = k.stride;
+  u.phases[0] = {NodalVector{records, S, k.solid_velocity},
+                 NodalVector{records, S, k.solid_acceleration},
+                 NodalVector{records, S, k.solid_mass}};
+  u.phases[1] = {NodalVector{records, S, k.water_velocity},
+                 NodalVector{records, S, k.water_acceleration},
+                 NodalVector{records, S, k.water_mass}};
+  u.count = 2;
+  u.dt = dt;
+  u.porosity = NodalVector{records, S, k.porosity};
+  sim.constrain_update(u);
+  follow_held_phases<D>(records, k, solved, sim.grid.num_nodes, sim.threads, sim.mass_tolerance,
+                        dt);
 }
 
 /// Square of the fastest wave speed of the undamped (drag-free) two-phase equations: the largest

@@ -186,7 +186,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   /// created inside the soil fills only its pores.
   void initialize_particles(Simulation<D>& sim, ParticleSet<D>& set, size_t b, size_t e) override {
     auto& P = set.particles;
-    const bool solid = &set == &solid_set(set);
+    const bool solid = &set == &sim.sets[kSolid];
     for (size_t i = b; i < e; ++i) {
       if (solid) {
         P.col(n_)[i] = n0_;
@@ -244,6 +244,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   // force -> acceleration, the weak form of div sigma_w (G), drag Q, solid volume -> porosity.
   static constexpr int kMs = 0, kMw = 1, kV = 2, kW = 2 + D, kF = 2 + 2 * D, kFw = 2 + 3 * D,
                        kG = 2 + 4 * D, kQ = 2 + 5 * D, kN = 3 + 5 * D, S = 4 + 5 * D;
+  static constexpr TwoPhaseRecord kRecord{kMs, kMw, kQ, kV, kW, kF, kFw, kN, S};
   static constexpr int NS = Particles<D>::NS;
   // Smallest porosity a liquid point divides by (its mixture volume V/n): a liquid point inside
   // a grain-filled region (n_I -> 0 where solid points overlap) keeps a finite weight.
@@ -275,10 +276,6 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     long bad_volume = -1;    // a liquid point compressed to zero volume this step
   };
   std::vector<std::unique_ptr<Scratch>> scratch_;
-
-  static ParticleSet<D>& solid_set(ParticleSet<D>& any) {
-    return *(&any - (any.name == "liquid" ? 1 : 0));
-  }
 
   /// A liquid body needs a fluid material (its stress from its density), a solid body an
   /// effective-stress model: located errors at the body's material.
@@ -405,7 +402,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     sim.timed("grid", [&] { zero_nodes(remap_, sim.threads); });
     sim.timed("g2p_velocity_remap", [&] {
       sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-        remap<NPP>(sim, s, s.name == "liquid" ? kLiquid : kSolid, dt, b, c, t);
+        remap<NPP>(sim, s, &s == &sim.sets[kSolid] ? kSolid : kLiquid, dt, b, c, t);
       });
     });
     sim.timed("grid", [&] { remapped_velocities(sim); });
@@ -566,15 +563,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     boundary_forces(sim);
     damp_solid(sim);
     solve_coupled(sim, dt);
-    GridUpdate u;
-    double* g = node_.data();
-    u.phases[0] = {NodalVector{g, S, kV}, NodalVector{g, S, kF}, NodalVector{g, S, kMs}};
-    u.phases[1] = {NodalVector{g, S, kW}, NodalVector{g, S, kFw}, NodalVector{g, S, kMw}};
-    u.count = 2;
-    u.dt = dt;
-    u.porosity = NodalVector{g, S, kN};
-    sim.constrain_update(u);
-    follow_held_phases(sim, dt);
+    constrain_two_phase_update<D>(sim, node_.data(), kRecord, solved_.data(), dt);
   }
 
   /// n_I = 1 - V_s,I / V_I in [0, 1]; F_w += n_I G_I, F_s += (1 - n_I) G_I (see the header).
@@ -643,11 +632,6 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         r[kFw + d] = has_w ? (wn - w) / dt : 0.0;
       }
     });
-  }
-
-  void follow_held_phases(Simulation<D>& sim, double dt) {
-    loam::follow_held_phases<D>(node_.data(), {kMs, kMw, kQ, kV, kW, kF, kFw, S}, solved_.data(),
-                                sim.grid.num_nodes, sim.threads, sim.mass_tolerance, dt);
   }
 
   /// f(record, node) for every grid node, in parallel (static schedule).
@@ -735,14 +719,21 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     const double* g = node_.data();
     double* contact = P.col(contact_) + b;
     bool fluidised = false;
+    // The smoothed (nodal) porosity field at point p: only fluidised points read it.
+    auto grid_porosity = [&](int p) {
+      double n = 0;
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        n += st.w[kp] * g[size_t(st.node[kp]) * S + kN];
+      }
+      return n;
+    };
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      // L_s, and the smoothed (nodal) porosity field at the point, for a fluidised point.
-      double l[D][D] = {}, n_grid = 0;
+      double l[D][D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         add_velocity_gradient<D>(l, remap_.data() + size_t(st.node[kp]) * 2 * D, st, size_t(k), p);
-        n_grid += st.w[kp] * g[size_t(st.node[kp]) * S + kN];
       }
       move_point(sim.held_faces, P, i, move + size_t(p) * D);
       store_velocity_gradient<D>(l, L, p);
@@ -750,20 +741,26 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       double& n = P.col(n_)[i];
       const double Vs = (1 - n) * V;  // solid volume, conserved
       const double J = update_volume_and_deformation<D>(l, dt, V, F, p);
+      // Fluidised: no effective stress, the grid's porosity (at least n_max), solid volume kept.
+      auto fluidise = [&](double n_grid) {
+        n = std::max(n_grid, n_max_);
+        V = Vs / (1 - n);
+        fluidised = true;
+      };
       if (contact[p] > 0) {
         n = 1 - (1 - n) / J;
-        if (n >= n_max_) contact[p] = 0;
-      } else if (n_grid < n_max_ && volume_rate(l) < 0) {
+        if (n >= n_max_) {
+          contact[p] = 0;
+          fluidise(grid_porosity(p));
+        }
+      } else if (const double n_grid = grid_porosity(p); n_grid < n_max_ && volume_rate(l) < 0) {
         contact[p] = 1;  // compressed below n_max: the grains touch again, sigma' from 0
         // Not denser than the initial packing: where points crowd the nodal field dips towards
         // 0, and a grain at near-zero porosity is crushed to a negative one by the next step.
         n = std::max(n_grid, n0_);
         V = Vs / (1 - n);
-      }
-      if (contact[p] == 0) {
-        n = std::max(n_grid, n_max_);
-        V = Vs / (1 - n);
-        fluidised = true;
+      } else {
+        fluidise(n_grid);
       }
       if (!(n > 0 && n < 1)) sc.bad_porosity = long(i);
     }
@@ -787,9 +784,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     }
   }
 
-  /// Liquid points: L_w from the re-mapped water velocities; n, grad n, u_s and div u_s at the
-  /// point from the grid; the intrinsic volume from both mass balances (seed 003 eq. 12, see
-  /// the header); the move. L_w is kept for the stress update after the smoothing.
+  /// Liquid points: L_w from the re-mapped water velocities, the storage rate from both phases'
+  /// re-mapped velocities and the nodal porosity (seed 003 eq. 12, see the header), the
+  /// intrinsic volume, the move. L_w is kept for the stress update after the smoothing.
   template <int NPP>
   void update_liquid(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
                      int thread) {

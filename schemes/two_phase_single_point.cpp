@@ -232,6 +232,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   // volume -> porosity.
   static constexpr int kMs = 0, kMw = 1, kV = 2, kW = 2 + D, kF = 2 + 2 * D, kFw = 2 + 3 * D,
                        kQ = 2 + 4 * D, kN = 3 + 4 * D, S = 4 + 4 * D;
+  static constexpr TwoPhaseRecord kRecord{kMs, kMw, kQ, kV, kW, kF, kFw, kN, S};
   static constexpr int NS = Particles<D>::NS;
   std::unique_ptr<Drag<D>> drag_;
   double n0_, Kw_, flip_, rho_w_ = 1000;
@@ -375,15 +376,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     sim.apply_boundary_forces(f);
     damp_mixture(sim);
     solve_coupled(sim, dt);
-    GridUpdate u;
-    double* g = node_.data();
-    u.phases[0] = {NodalVector{g, S, kV}, NodalVector{g, S, kF}, NodalVector{g, S, kMs}};
-    u.phases[1] = {NodalVector{g, S, kW}, NodalVector{g, S, kFw}, NodalVector{g, S, kMw}};
-    u.count = 2;
-    u.dt = dt;
-    u.porosity = NodalVector{g, S, kN};
-    sim.constrain_update(u);
-    follow_held_phase(sim, dt);
+    constrain_two_phase_update<D>(sim, node_.data(), kRecord, solved_.data(), dt);
   }
 
   /// Per node: the porosity n_I = m_w / (rho_w V_I) and the water force
@@ -448,12 +441,6 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         r[kFw + d] = (wn - w) / dt;
       }
     });
-  }
-
-  /// A phase held by a condition drags its free partner (framework/two_phase_blocks.hpp).
-  void follow_held_phase(Simulation<D>& sim, double dt) {
-    follow_held_phases<D>(node_.data(), {kMs, kMw, kQ, kV, kW, kF, kFw, S}, solved_.data(),
-                          sim.grid.num_nodes, sim.threads, sim.mass_tolerance, dt);
   }
 
   /// MUSL first pass: FLIP/PIC update of both particle velocities and the scatter of their new

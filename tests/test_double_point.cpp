@@ -885,3 +885,22 @@ TEST_CASE(
   CHECK(peak < 1.2);
   CHECK(peak_fixed > 1.8);
 }
+
+TEST_CASE("reservoir and scour_depth: a box outside the grid and a wrong axis are located errors",
+          "[sources][reference][cli]") {
+  loam_test::TempDir dir("reservoir_bad");
+  const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/permeameter_double_point.yaml";
+  auto r = loam_test::run_loam(
+      "run " + cfg + " --quiet --out " + dir.path.string() +
+      " --set 'sources.0={type: reservoir, body: water, min: [1.1], max: [1.5], refill: x+}'" +
+      " --set 'verify={type: scour_depth, axis: [0.5, 0.5]}'");
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find(
+            "error: sources.0: the reservoir [1.1] to [1.5] is outside the grid [0] to [1.2]") !=
+        std::string::npos);
+  CHECK(
+      r.output.find("error: verify.axis: give 0 coordinate(s): the horizontal axes of a 1D run") !=
+      std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir.path));
+}
