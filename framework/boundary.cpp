@@ -79,6 +79,43 @@ template std::vector<double> face_node_areas<2>(const Grid<2>&, const Face&,
                                                 const std::vector<size_t>&);
 template std::vector<double> face_node_areas<3>(const Grid<3>&, const Face&,
                                                 const std::vector<size_t>&);
+void add_face_or_box_params(Schema& s, bool face_required_otherwise) {
+  s.choice("face", face_names(), "grid face (or min and max: a box of nodes inside the grid)");
+  s.vector("min", "m", "lower corner of a box whose nodes are held (instead of face)");
+  s.vector("max", "m", "upper corner of a box whose nodes are held (instead of face)");
+  s.check([face_required_otherwise](const Params& p, Diagnostics& d) {
+    const bool box = p.has("min") || p.has("max");
+    if ((face_required_otherwise && p.has("face") == box) || (p.has("face") && box) ||
+        p.has("min") != p.has("max"))
+      d.error(p.where(), p.path(), "give either face or both min and max (a box of nodes)");
+    else if (box)  // a box of nodes may be flat (a sheet: one row of nodes), not inverted
+      for (size_t k = 0; k < p.vec("min").size() && k < p.vec("max").size(); ++k)
+        if (p.vec("max")[k] < p.vec("min")[k])
+          d.error(p.where("max"), p.path("max"),
+                  "max is below min along axis " + std::to_string(k) + ": an empty box");
+  });
+}
+
+template <int D>
+std::vector<size_t> box_nodes(const Grid<D>& g, const Params& p, Diagnostics& diag) {
+  std::vector<size_t> out;
+  for (size_t n = 0; n < g.num_nodes; ++n) {
+    bool in = true;
+    for (int d = 0; d < D; ++d) {
+      const double x = g.node_coord(n, d), tol = 1e-9 * g.cell[size_t(d)];
+      in = in && x >= p.vec("min")[size_t(d)] - tol && x <= p.vec("max")[size_t(d)] + tol;
+    }
+    if (in) out.push_back(n);
+  }
+  if (out.empty())
+    diag.error(p.where("min"), p.path("min"),
+               "the box holds no grid node (a structure must span at least one node)");
+  return out;
+}
+
+template std::vector<size_t> box_nodes<1>(const Grid<1>&, const Params&, Diagnostics&);
+template std::vector<size_t> box_nodes<2>(const Grid<2>&, const Params&, Diagnostics&);
+template std::vector<size_t> box_nodes<3>(const Grid<3>&, const Params&, Diagnostics&);
 template std::vector<size_t> face_nodes<1>(const Grid<1>&, const Face&);
 template std::vector<size_t> face_nodes<2>(const Grid<2>&, const Face&);
 template std::vector<size_t> face_nodes<3>(const Grid<3>&, const Face&);

@@ -221,4 +221,12 @@ std::vector<double> face_node_areas(const Grid<D>& grid, const Face& face,
                                     const std::vector<size_t>& nodes);
 const std::vector<std::string>& face_names();
 
+/// A condition on a box of nodes inside the grid instead of a face (fixed, slip: a sheet pile,
+/// a wall, a footing): the schema keys `min` and `max` beside `face`, exactly one of the two
+/// ways checked (a box may be flat, one row of nodes, not inverted).
+void add_face_or_box_params(Schema& s, bool face_required_otherwise);
+/// The nodes inside [min, max] of p (to 1e-9 of a cell); a located error if there is none.
+template <int D>
+std::vector<size_t> box_nodes(const Grid<D>& grid, const Params& p, Diagnostics& d);
+
 }  // namespace loam

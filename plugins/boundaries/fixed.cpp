@@ -17,20 +17,8 @@ class Fixed : public Boundary<D> {
   static constexpr const char* summary = "no-slip grid face: all velocity components zero";
   static Schema schema() {
     Schema s;
-    s.choice("face", face_names(), "grid face (or min and max: a box of nodes inside the grid)");
-    s.vector("min", "m", "lower corner of a box whose nodes are held (instead of face)");
-    s.vector("max", "m", "upper corner of a box whose nodes are held (instead of face)");
+    add_face_or_box_params(s, /*face_required_otherwise=*/true);
     add_phase_param(s);
-    s.check([](const Params& p, Diagnostics& d) {
-      const bool box = p.has("min") || p.has("max");
-      if (p.has("face") == box || p.has("min") != p.has("max"))
-        d.error(p.where(), p.path(), "give either face or both min and max (a box of nodes)");
-      else if (box)  // a box of nodes may be flat (a sheet: one row of nodes), not inverted
-        for (size_t k = 0; k < p.vec("min").size() && k < p.vec("max").size(); ++k)
-          if (p.vec("max")[k] < p.vec("min")[k])
-            d.error(p.where("max"), p.path("max"),
-                    "max is below min along axis " + std::to_string(k) + ": an empty box");
-    });
     return s;
   }
   explicit Fixed(const Params& p)
@@ -42,7 +30,7 @@ class Fixed : public Boundary<D> {
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     check_phase_mask(phases_, sim.scheme->phases(), params_, diag);
     if (box_)
-      box_nodes(sim, diag);
+      nodes_ = box_nodes(sim.grid, params_, diag);
     else if (check_face(face_, D, params_, "face", diag))
       nodes_ = face_nodes(sim.grid, face_);
   }
@@ -65,23 +53,6 @@ class Fixed : public Boundary<D> {
   bool box_;
   int phases_;  // bit 0 solid, bit 1 water
   std::vector<size_t> nodes_;
-
-  /// The nodes inside [min, max] (to 1e-9 of a cell), at least one.
-  void box_nodes(const Simulation<D>& sim, Diagnostics& diag) {
-    const Grid<D>& g = sim.grid;
-    for (size_t n = 0; n < g.num_nodes; ++n) {
-      bool in = true;
-      for (int d = 0; d < D; ++d) {
-        const double x = g.node_coord(n, d), tol = 1e-9 * g.cell[size_t(d)];
-        in = in && x >= params_.vec("min")[size_t(d)] - tol &&
-             x <= params_.vec("max")[size_t(d)] + tol;
-      }
-      if (in) nodes_.push_back(n);
-    }
-    if (nodes_.empty())
-      diag.error(params_.where("min"), params_.path("min"),
-                 "the box holds no grid node (a structure must span at least one node)");
-  }
 };
 
 LOAM_REGISTER(Boundary, Fixed)

@@ -1,6 +1,11 @@
 // Slip (roller) grid face: the normal velocity component is zero, tangential motion is free.
 // `directions` fixes other components instead (slip per direction). The held components are
 // marked (mark_held): a friction face meeting this one at an edge slides only in the others.
+// With `min` and `max` instead of `face` it acts on every node of that box inside the grid, with
+// the components named in `directions`: a smooth structure, e.g. a sheet pile the pore water
+// flows along (phase: water, directions: [x]: impermeable across it, free along it, as Darcy
+// flow past a wall is; a no-slip `fixed` box would also stop the flow along it, widening the
+// pile by a cell on each side). A box holds its nodes only, not the particles.
 #include <algorithm>
 
 #include "framework/registry.hpp"
@@ -16,18 +21,30 @@ class Slip : public Boundary<D> {
       "roller grid face: normal velocity zero (or chosen components)";
   static Schema schema() {
     Schema s;
-    s.choice("face", face_names(), "grid face").required();
+    add_face_or_box_params(s, /*face_required_otherwise=*/true);
     add_phase_param(s);
-    s.string_list("directions", "components to fix (x, y, z); default: the face normal");
+    s.string_list("directions",
+                  "components to fix (x, y, z); default: the face normal (required with a box)");
+    s.check([](const Params& p, Diagnostics& d) {
+      if (p.has("min") && !p.has("directions"))
+        d.error(p.where(), p.path(), "a box has no normal: give directions (e.g. [x])");
+    });
     return s;
   }
   explicit Slip(const Params& p)
-      : params_(p), face_(parse_face(p.text("face"))), phases_(parse_phase_mask(p)) {}
+      : params_(p),
+        face_(parse_face(p.has("face") ? p.text("face") : "x-")),
+        box_(!p.has("face")),
+        phases_(parse_phase_mask(p)) {}
   bool applies_to(int phase) const override { return (phases_ >> phase) & 1; }
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     check_phase_mask(phases_, sim.scheme->phases(), params_, diag);
-    if (!check_face(face_, D, params_, "face", diag)) return;
-    nodes_ = face_nodes(sim.grid, face_);
+    if (box_)
+      nodes_ = box_nodes(sim.grid, params_, diag);
+    else if (!check_face(face_, D, params_, "face", diag))
+      return;
+    else
+      nodes_ = face_nodes(sim.grid, face_);
     if (!params_.has("directions")) {
       fixed_.push_back(face_.axis);
       return;
@@ -54,12 +71,13 @@ class Slip : public Boundary<D> {
   /// tangential component: the particles may leave through x-).
   int holds_face(int phase) const override {
     const bool normal = std::find(fixed_.begin(), fixed_.end(), face_.axis) != fixed_.end();
-    return normal && applies_to(phase) ? face_index(face_) : -1;
+    return normal && applies_to(phase) && !box_ ? face_index(face_) : -1;
   }
 
  private:
   Params params_;
   Face face_;
+  bool box_;
   int phases_;  // bit 0 solid, bit 1 water
   std::vector<size_t> nodes_;
   std::vector<int> fixed_;

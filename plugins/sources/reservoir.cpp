@@ -10,6 +10,12 @@
 // nearest that face is a spacing s or more inside the face's layer of lattice sites, a new layer
 // is created one spacing behind it (repeatedly, while the gap allows), at the mean velocity of
 // the body's particles in the box. The created mass is counted in the run's mass balance.
+//
+// A rising pool (the upstream side of a sheet pile raised slowly, seed 000): `level` puts the
+// refill face inside the box at t = 0 and `level_rate` moves it outward along its axis at a
+// constant speed, level(t) = level + level_rate t, until it reaches the box's own face, where
+// it stays. The face layer is then the last lattice site at or inside level(t). (A general
+// time function for sources is issue 16; this is its constant-rate case.)
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -39,10 +45,19 @@ class Reservoir : public Source<D> {
              "the side of the box where new layers come in: its free surface (y+ in 2D, z+ in 3D "
              "for a pool under gravity) or the far end of a supply")
         .required();
+    s.real("level", "m",
+           "position of the refill face along its axis at t = 0, inside the box (default: the "
+           "box's face)");
+    s.real("level_rate", "m/s",
+           "speed at which the refill face moves outward (a rising pool), until it reaches the "
+           "box's face")
+        .def("0")
+        .non_negative();
     s.check([](const Params& p, Diagnostics& d) { check_box_corners(p, d); });
     return s;
   }
-  explicit Reservoir(const Params& p) : params_(p), refill_(parse_face(p.text("refill"))) {
+  explicit Reservoir(const Params& p)
+      : params_(p), refill_(parse_face(p.text("refill"))), rate_(p.real("level_rate")) {
     for (int d = 0; d < D; ++d) {
       lo_[size_t(d)] = p.vec("min")[size_t(d)];
       hi_[size_t(d)] = p.vec("max")[size_t(d)];
@@ -63,10 +78,25 @@ class Reservoir : public Source<D> {
       return;
     }
     box_lattice<D>(g, lo_, hi_, s_, refill_.axis, refill_.upper, sites_, layer_);
-    if (sites_.empty())
+    if (sites_.empty()) {
       diag.error(params_.where(), params_.path(),
                  "the reservoir holds no lattice site of body '" + body.name +
                      "' (thinner than its particle spacing?)");
+      return;
+    }
+    const int a = refill_.axis;
+    origin_ = g.origin[size_t(a)];
+    const double face = refill_.upper ? hi_[size_t(a)] : lo_[size_t(a)];
+    level0_ = params_.has("level") ? params_.real("level") : face;
+    if (level0_ < lo_[size_t(a)] || level0_ > hi_[size_t(a)])
+      diag.error(params_.where("level"), params_.path("level"),
+                 "level " + format_number(level0_) + " is outside the box along axis " +
+                     std::to_string(a) + " [" + format_number(lo_[size_t(a)]) + ", " +
+                     format_number(hi_[size_t(a)]) + "]");
+    else if (!reaches(face_site(0.0)))
+      diag.error(params_.where("level"), params_.path("level"),
+                 "no lattice site of body '" + body.name + "' lies inside level " +
+                     format_number(level0_) + " (spacing " + format_number(s_[size_t(a)]) + ")");
   }
 
   void region(Vec& lower, Vec& upper) const override { lower = lo_, upper = hi_; }
@@ -74,7 +104,6 @@ class Reservoir : public Source<D> {
   void apply(Simulation<D>& sim, double) override {
     if (body_ < 0 || layer_.empty()) return;
     const int a = refill_.axis;
-    const double sign = refill_.upper ? 1.0 : -1.0;
     // The body's particles in the box: the one nearest the refill side, and their mean velocity.
     const Particles<D>& P = sim.particles_of_body(body_);
     double nearest = -std::numeric_limits<double>::infinity();  // sign * coordinate
@@ -88,21 +117,24 @@ class Reservoir : public Source<D> {
         in = in && x >= lo_[size_t(d)] && x <= hi_[size_t(d)];
       }
       if (!in) continue;
-      nearest = std::max(nearest, sign * P.col(P.position, a)[i]);
+      nearest = std::max(nearest, sign() * P.col(P.position, a)[i]);
       for (int d = 0; d < D; ++d) v[size_t(d)] += P.col(P.velocity, d)[i];
       ++count;
     }
-    if (count == 0) {  // empty: fill it
-      sim.add_particles(body_, sites_, Vec{});
+    const double site = sign() * face_site(sim.time), sa = s_[size_t(a)];
+    if (count == 0) {  // empty: fill it up to the level
+      std::vector<Vec> x;
+      for (const Vec& y : sites_)
+        if (sign() * y[size_t(a)] <= site + 1e-9 * sa) x.push_back(y);
+      sim.add_particles(body_, x, Vec{});
       return;
     }
     for (int d = 0; d < D; ++d) v[size_t(d)] /= double(count);
-    const double site = sign * layer_[0][size_t(a)], sa = s_[size_t(a)];
     std::vector<Vec> x;
     while (site - nearest >= sa * (1 - 1e-9)) {
       nearest += sa;
       for (Vec y : layer_) {
-        y[size_t(a)] = sign * nearest;
+        y[size_t(a)] = sign() * nearest;
         x.push_back(y);
       }
     }
@@ -110,9 +142,29 @@ class Reservoir : public Source<D> {
   }
 
  private:
+  double sign() const { return refill_.upper ? 1.0 : -1.0; }
+  /// The coordinate of the face layer at time t: the last lattice site at or inside
+  /// level(t) = level + level_rate t (outward), never beyond the box's own end layer.
+  double face_site(double t) const {
+    const int a = refill_.axis;
+    const double sa = s_[size_t(a)], level = level0_ + sign() * rate_ * t;
+    const double k = (level - origin_) / sa - 0.5, end = layer_[0][size_t(a)];
+    const double y =
+        origin_ + ((refill_.upper ? std::floor(k + 1e-9) : std::ceil(k - 1e-9)) + 0.5) * sa;
+    return sign() * std::min(sign() * y, sign() * end);
+  }
+  /// Some lattice site of the box lies at or inside the face coordinate y.
+  bool reaches(double y) const {
+    const int a = refill_.axis;
+    for (const Vec& x : sites_)
+      if (sign() * x[size_t(a)] <= sign() * y + 1e-9 * s_[size_t(a)]) return true;
+    return false;
+  }
+
   Params params_;
   Face refill_;
   Vec lo_{}, hi_{}, s_{};
+  double rate_ = 0, level0_ = 0, origin_ = 0;  // origin_: the grid origin along the axis
   int body_ = -1;
   std::vector<Vec> sites_, layer_;  // every lattice site of the box; those of the refill layer
 };

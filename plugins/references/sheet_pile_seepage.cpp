@@ -1,0 +1,265 @@
+// Reference: seepage under a single impermeable sheet pile and the onset of piping (seed 000;
+// docs/verification.md I). Harr (1962, Groundwater and Seepage, ch. 3, conformal mapping): a
+// pile driven to depth d into a homogeneous layer of infinite depth, the water levels differing
+// by ΔH across it, has the head field
+//   h(x, y) = h_down + (ΔH / π) Re[arccos(t / d)],   t = ±√(z² + d²),  z = (x - x_pile) + i (y -
+//   y_s)
+// (the sign of t that of x - x_pile: + downstream), so the exit gradient at the downstream
+// surface a distance x from the pile is ΔH / (π √(x² + d²)), at the pile i_exit = ΔH / (π d).
+// With the critical gradient i_c = (G_s - 1)(1 - n) = γ'/γ_w the soil next to the pile
+// fluidises at ΔH_c = π d i_c (the exit-gradient criterion); Terzaghi's prism d deep and d/2 wide
+// heaves when the mean excess head on its base reaches i_c d, ΔH_c = i_c d / h̄, with h̄/ΔH the
+// mean of Harr's head on the base (0.354 ΔH: ΔH_c = 2.83 i_c d).
+//
+// What it measures, every `every` seconds:
+// - the head difference ΔH = h_up - h_down: the mean head p/γ_w + y of the pressure set's points
+//   within `head_band` above the soil surface, on each side, at least d/2 from the pile;
+// - the exit gradient: -dh/dy, the least-squares slope of the head of the points in the exit
+//   window (x_pile ≤ x ≤ x_pile + width, y_s - depth ≤ y ≤ y_s), over the cell means of
+//   pressure and position (a scheme may hold one pressure per cell); Harr's gradient is fitted
+//   the same way from his head field at the same cell centroids, so the window does not bias it;
+// - the fluidised points of the bed (a `contact` field of 0) downstream of the pile, and the heave:
+//   the rise of the highest grain of the bed within d/2 downstream of the pile.
+// Metrics: exit_gradient_error (the slope through the origin of the measured exit gradient
+// against Harr's over the intact samples with ΔH ≥ ΔH_c/4, minus 1), critical_head (ΔH at the
+// first sample with a fluidised grain downstream; NaN if none), critical_head_harr (π d i_c),
+// critical_head_prism, critical_head_error (against Harr), heave and fluidised_points at the
+// end, critical_gradient.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+#include "plugins/references/sheet_pile.hpp"
+
+namespace loam {
+
+template <int D>
+class SheetPileSeepage : public Reference<D> {
+ public:
+  static constexpr const char* name = "sheet_pile_seepage";
+  static constexpr const char* summary =
+      "seepage under a sheet pile: exit gradient and critical head against Harr (seed 000 "
+      "piping)";
+  static Schema schema() {
+    Schema s;
+    s.text("body", "the soil (default: the first body)");
+    s.real("pile", "m", "position of the pile along the first axis (downstream is +x)").required();
+    s.real("depth", "m", "embedment d of the pile below the soil surface").positive().required();
+    s.real("surface", "m",
+           "level of the soil surface (default: the top of the soil body's domain)");
+    s.text("pressure_set",
+           "the set whose points carry the pore pressure (default: the scheme's last set: "
+           "`liquid` in the double-point scheme)");
+    s.real("water_density", "kg/m^3", "density of the water (γ_w = ρ_w g)").def("1000").positive();
+    s.real("critical_gradient", "-",
+           "i_c (default: (ρ_s/ρ_w - 1)(1 - n0) from the soil's density and scheme.porosity)")
+        .positive();
+    s.real_list("exit_window", "m",
+                "width and depth of the exit window next to the pile, downstream (default: d/4 "
+                "and d/2; at least two cell rows deep)");
+    s.real("head_band", "m",
+           "height of the band above the soil surface where the side heads are measured "
+           "(default: d/4)")
+        .positive();
+    s.real("every", "s", "sampling interval").def("0.05").positive();
+    return s;
+  }
+  explicit SheetPileSeepage(const Params& p)
+      : params_(p), x_pile_(p.real("pile")), d_(p.real("depth")), every_(p.real("every")) {}
+
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    if (D < 2) {
+      diag.error(params_.where(), params_.path(), "sheet_pile_seepage needs a 2D or 3D run");
+      return;
+    }
+    body_ = sim.body_param(params_, "body", diag);
+    if (body_ < 0) return;
+    const Body& b = sim.bodies[size_t(body_)];
+    surface_ = params_.has("surface") ? params_.real("surface") : b.upper[D - 1];
+    set_ = params_.has("pressure_set") ? sim.set_param(params_, "pressure_set", diag)
+                                       : int(sim.sets.size()) - 1;
+    if (set_ < 0) return;
+    pressure_ = sim.sets[size_t(set_)].particles.find("pore_pressure");
+    if (pressure_ < 0) {
+      diag.error(params_.where(), params_.path(),
+                 "the points of set '" + sim.sets[size_t(set_)].name +
+                     "' carry no pore pressure: give pressure_set");
+      return;
+    }
+    contact_ = sim.particles_of_body(body_).find("contact");
+    gamma_w_ = params_.real("water_density") * std::fabs(sim.gravity[D - 1]);
+    if (!(gamma_w_ > 0)) {
+      diag.error(params_.where(), params_.path(), "needs gravity along the last axis");
+      return;
+    }
+    if (params_.has("critical_gradient")) {
+      i_c_ = params_.real("critical_gradient");
+    } else {
+      const Params& scheme = sim.config.section("scheme");
+      if (!scheme.has("porosity")) {
+        diag.error(params_.where(), params_.path(),
+                   "the scheme has no porosity: give critical_gradient");
+        return;
+      }
+      const double rho_s = b.params.section("material").real("density");
+      i_c_ = (rho_s / params_.real("water_density") - 1) * (1 - scheme.real("porosity"));
+    }
+    width_ = band_ = d_ / 4, depth_ = d_ / 2;
+    if (params_.has("exit_window")) {
+      const auto& w = params_.vec("exit_window");
+      if (w.size() != 2 || !(w[0] > 0) || !(w[1] > 0)) {
+        diag.error(params_.where("exit_window"), params_.path("exit_window"),
+                   "give two positive lengths: [width, depth]");
+        return;
+      }
+      width_ = w[0], depth_ = w[1];
+    }
+    if (depth_ < 2 * sim.grid.cell[D - 1] * (1 - 1e-9))
+      diag.error(params_.where(), params_.path(),
+                 "the exit window (" + format_number(depth_) +
+                     " m deep) must span two cell rows (" +
+                     format_number(2 * sim.grid.cell[D - 1]) +
+                     " m): give a deeper exit_window or a finer grid");
+    if (params_.has("head_band")) band_ = params_.real("head_band");
+    heave_base_ = strip_top(sim);
+    if (!std::isfinite(heave_base_))
+      diag.error(params_.where("pile"), params_.path("pile"),
+                 "no grain of the soil lies within d/2 downstream of the pile");
+  }
+
+  void sample(Simulation<D>& sim) override {
+    if (sim.time < next_ * (1 - 1e-12) - 1e-15) return;
+    next_ = (std::floor(sim.time / every_ + 1e-9) + 1) * every_;
+    const Particles<D>& P = sim.sets[size_t(set_)].particles;
+    const double* y = P.col(P.position, D - 1);
+    const double* x = P.col(P.position, 0);
+    const double* p = P.col(pressure_);
+    // Side heads in the water over the soil.
+    double up = 0, down = 0;
+    size_t n_up = 0, n_down = 0;
+    for (size_t i = 0; i < P.size(); ++i) {
+      if (y[i] < surface_ || y[i] > surface_ + band_) continue;
+      const double h = p[i] / gamma_w_ + y[i];
+      if (x[i] < x_pile_ - d_ / 2) up += h, ++n_up;
+      if (x[i] > x_pile_ + d_ / 2) down += h, ++n_down;
+    }
+    const double h_up = n_up ? up / double(n_up) : std::nan("");
+    const double h_down = n_down ? down / double(n_down) : std::nan("");
+    const double dH = h_up - h_down;
+    // Exit gradient: least-squares slope of the head against y over the window's cells (cell
+    // means of pressure and position: a scheme may hold one pressure per cell), measured and
+    // Harr's at the same cell centroids.
+    std::map<std::array<long, D>, std::array<double, 4>> cells;  // sum x, y, p; count
+    for (size_t i = 0; i < P.size(); ++i) {
+      if (x[i] < x_pile_ || x[i] > x_pile_ + width_ || y[i] > surface_ || y[i] < surface_ - depth_)
+        continue;
+      std::array<long, D> c{};
+      for (int d = 0; d < D; ++d)
+        c[size_t(d)] = long(std::floor((P.col(P.position, d)[i] - sim.grid.origin[size_t(d)]) *
+                                       sim.grid.inv_cell[size_t(d)]));
+      auto& a = cells[c];
+      a[0] += x[i], a[1] += y[i], a[2] += p[i], a[3] += 1;
+    }
+    double sy = 0, sh = 0, shh = 0, syy = 0, syh = 0, syhh = 0, n = 0;
+    for (const auto& [c, a] : cells) {
+      const double w = a[3], xc = a[0] / w, yc = a[1] / w;
+      const double h = a[2] / w / gamma_w_ + yc;
+      const double hh = dH * harr_head_fraction(xc - x_pile_, yc - surface_, d_);
+      sy += w * yc, sh += w * h, shh += w * hh, syy += w * yc * yc, syh += w * yc * h;
+      syhh += w * yc * hh, n += w;
+    }
+    const double var = syy - sy * sy / n;
+    const bool fit = cells.size() >= 2 && var > 1e-12 * depth_ * depth_ * n;
+    const double i_exit = fit ? -(syh - sy * sh / n) / var : std::nan("");
+    const double i_harr = fit ? -(syhh - sy * shh / n) / var : std::nan("");
+    // Fluidised grains downstream and the heave next to the pile.
+    const Particles<D>& S = sim.particles_of_body(body_);
+    long fluidised = 0;
+    if (S.has(contact_))
+      for (size_t i = 0; i < S.size(); ++i)
+        if (S.body[i] == body_ && S.col(contact_)[i] == 0 && S.col(S.position, 0)[i] > x_pile_)
+          ++fluidised;
+    time_.push_back(sim.time);
+    head_.push_back(dH);
+    up_.push_back(h_up);
+    down_.push_back(h_down);
+    exit_.push_back(i_exit);
+    harr_.push_back(i_harr);
+    fluidised_.push_back(double(fluidised));
+    heave_.push_back(strip_top(sim) - heave_base_);
+    if (fluidised > 0 && !std::isfinite(critical_)) critical_ = dH;
+  }
+
+  std::map<std::string, double> metrics(Simulation<D>& sim) override {
+    if (time_.empty() || time_.back() < sim.time) {
+      next_ = 0;  // the end of the run is always sampled
+      sample(sim);
+    }
+    const double harr = M_PI * d_ * i_c_;
+    // Intact samples with a head difference large enough to measure against.
+    double num = 0, den = 0;
+    for (size_t k = 0; k < time_.size(); ++k) {
+      if (fluidised_[k] > 0 || !(head_[k] >= harr / 4) || !std::isfinite(exit_[k])) continue;
+      num += exit_[k] * harr_[k], den += harr_[k] * harr_[k];
+    }
+    return {{"exit_gradient_error", den > 0 ? num / den - 1 : std::nan("")},
+            {"critical_head", critical_},
+            {"critical_head_harr", harr},
+            {"critical_head_prism", i_c_ * d_ / prism_mean_head()},
+            {"critical_head_error", critical_ / harr - 1},
+            {"critical_gradient", i_c_},
+            {"head_difference", head_.back()},
+            {"exit_gradient", exit_.back()},
+            {"heave", heave_.back()},
+            {"fluidised_points", fluidised_.back()}};
+  }
+
+  std::vector<std::pair<std::string, std::vector<double>>> series() const override {
+    return {{"time", time_},
+            {"head_difference", head_},
+            {"head_upstream", up_},
+            {"head_downstream", down_},
+            {"exit_gradient", exit_},
+            {"exit_gradient_harr", harr_},
+            {"fluidised_points", fluidised_},
+            {"heave", heave_}};
+  }
+
+ private:
+  /// Terzaghi's prism: the mean of Harr's excess head fraction on its base (depth d, from the
+  /// pile to d/2 downstream), by Simpson's rule on 200 intervals.
+  double prism_mean_head() const {
+    const int m = 200;
+    double s = 0;
+    for (int k = 0; k <= m; ++k) {
+      const double w = (k == 0 || k == m) ? 1 : (k % 2 ? 4 : 2);
+      s += w * harr_head_fraction(0.5 * d_ * k / m + 1e-12 * d_, -d_, d_);
+    }
+    return s / (3.0 * m);
+  }
+  /// The highest grain of the bed within d/2 downstream of the pile (-inf if none).
+  double strip_top(const Simulation<D>& sim) const {
+    const Particles<D>& P = sim.particles_of_body(body_);
+    double top = -std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < P.size(); ++i) {
+      const double x = P.col(P.position, 0)[i];
+      if (P.body[i] != body_ || x < x_pile_ || x > x_pile_ + d_ / 2) continue;
+      top = std::max(top, P.col(P.position, D - 1)[i]);
+    }
+    return top;
+  }
+
+  Params params_;
+  double x_pile_, d_, every_, surface_ = 0, gamma_w_ = 0, i_c_ = 0;
+  double width_ = 0, depth_ = 0, band_ = 0, heave_base_ = 0, next_ = 0;
+  double critical_ = std::nan("");
+  int body_ = -1, set_ = -1, pressure_ = -1, contact_ = -1;
+  std::vector<double> time_, head_, up_, down_, exit_, harr_, fluidised_, heave_;
+};
+
+LOAM_REGISTER(Reference, SheetPileSeepage)
+
+}  // namespace loam

@@ -1,0 +1,199 @@
+// Seepage under a sheet pile (seed 000 piping; docs/verification.md I) and the pieces its scene
+// is built from: Harr's head field (plugins/references/sheet_pile.hpp), the reservoir's rising
+// level, a smooth (slip) box of nodes that the water flows along, the sheet_pile_seepage
+// reference's located errors, and the scene itself (configs/seed000_piping.yaml).
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdio>
+
+#include "cli.hpp"
+#include "plugins/references/sheet_pile.hpp"
+#include "sim_helpers.hpp"
+
+TEST_CASE("sheet pile: Harr's head field has his boundary values and exit gradient",
+          "[piping][verification]") {
+  // Reference: docs/verification.md I (Harr 1962): h/ΔH = 1 on the upstream surface, 0 on the
+  // downstream one, 1/2 at the tip and everywhere below it, 1/6 at mid-depth of the downstream
+  // face; the exit gradient at the pile -dh/dy = ΔH/(π d); Terzaghi's prism base (depth d, d/2
+  // wide) carries a mean of 0.354 ΔH. Tolerances: 1e-12 for values, 1e-5 for the differences.
+  using loam::harr_head_fraction;
+  const double d = 2.0;
+  CHECK(harr_head_fraction(-3.0, 0.0, d) == Approx(1.0).margin(1e-12));
+  CHECK(harr_head_fraction(3.0, 0.0, d) == Approx(0.0).margin(1e-12));
+  CHECK(harr_head_fraction(1e-12, -d, d) == Approx(0.5).margin(1e-6));
+  CHECK(harr_head_fraction(1e-12, -d / 2, d) == Approx(1.0 / 6).margin(1e-9));
+  CHECK(harr_head_fraction(-1e-12, -d / 2, d) == Approx(5.0 / 6).margin(1e-9));
+  for (double y : {-1.5 * d, -3 * d}) {  // below the tip: 1/2, continuous across x = 0
+    CHECK(harr_head_fraction(1e-9, y, d) == Approx(0.5).margin(1e-6));
+    CHECK(harr_head_fraction(-1e-9, y, d) == Approx(0.5).margin(1e-6));
+  }
+  const double e = 1e-4, exit = (harr_head_fraction(1e-9, -e, d) - 0.0) / e;
+  std::printf("Harr: exit gradient pi d i / dH = %.6f (1)\n", exit * M_PI * d);
+  CHECK(exit * M_PI * d == Approx(1.0).epsilon(1e-5));
+  double mean = 0;
+  const int m = 2000;
+  for (int k = 0; k < m; ++k) mean += harr_head_fraction(0.5 * d * (k + 0.5) / m, -d, d) / m;
+  std::printf("Harr: mean excess head on the prism base %.4f dH (0.354)\n", mean);
+  CHECK(mean == Approx(0.354).margin(0.001));
+}
+
+TEST_CASE("reservoir: a rising level adds layers at level + level_rate t until the box's face",
+          "[piping][sources]") {
+  // plugins/sources/reservoir.cpp: the face layer is the last lattice site inside level(t) =
+  // 0.5 + 1.0 t, capped at the box's top (1.5 m). Water alone (double-point scheme) in a slip
+  // box under gravity; the top point must stay within one spacing (0.05 m) plus the water's
+  // compression of level(t) while it rises, then at the top; the mass balance is round-off.
+  const std::string yaml = R"(
+grid: {origin: [0, 0], extent: [1, 2], cell_size: 0.1}
+gravity: [0, -9.81]
+scheme: {type: two_phase_double_point, porosity: 0.4, drag: {type: darcy, hydraulic_conductivity: 1.0e-3}}
+bodies:
+  - {name: pool, set: liquid, generator: {type: box, min: [0, 0], max: [1, 0.5]},
+     material: {type: newtonian_fluid, bulk_modulus: 2.0e6, viscosity: 1.0e-3, density: 1000},
+     stress: {type: linear_profile, value: [0, 0, 0, 0], gradient: [9810, 9810, 9810, 0], axis: 1, origin: 0.5}}
+boundaries:
+  - {type: fixed, face: y-}
+  - {type: slip, face: x-}
+  - {type: slip, face: x+}
+sources:
+  - {type: reservoir, body: pool, min: [0, 0], max: [1, 1.5], refill: y+, level: 0.5, level_rate: 1.0}
+time: {end: 2}
+)";
+  auto sim = loam_test::make_simulation<2>(yaml);
+  const auto& P = sim->sets[1].particles;
+  auto top = [&] {
+    double t = 0;
+    for (size_t i = 0; i < P.size(); ++i) t = std::max(t, P.col(P.position, 1)[i]);
+    return t;
+  };
+  for (double t_check : {0.3, 0.6, 0.9, 1.3}) {
+    while (sim->time < t_check) loam_test::advance(*sim, 1);
+    const double level = std::min(0.5 + sim->time, 1.5), z = top();
+    std::printf("reservoir at t = %.3f s: level %.3f m, top point %.4f m\n", sim->time, level, z);
+    CHECK(z <= level + 1e-9);
+    CHECK(z >= level - 0.05 - 0.02);  // one spacing, plus the column's compression (< 2 cm)
+  }
+  const double balance =
+      sim->total_mass() + sim->mass_removed - sim->mass_created - sim->initial_mass;
+  std::printf("reservoir: created %.2f kg/m, balance %.1e\n", sim->mass_created, balance);
+  CHECK(sim->mass_created > 900);  // about 1 m of water, 1 m wide
+  CHECK(std::fabs(balance) <= 1e-9 * sim->total_mass());
+}
+
+TEST_CASE("slip box: the water flows along a smooth pile and a fixed box stops it there",
+          "[piping][boundaries]") {
+  // plugins/boundaries/slip.cpp with min and max: the nodes of the box keep only the named
+  // components at zero. A block of water moving at (0, 1) m/s (no gravity) past a pile at
+  // x = 1 m: with slip (directions: [x]) every point keeps v_y = 1 to 1e-9 m/s and the block's
+  // mean height rises by t (1 m/s) to 1e-9 m after 20 steps; with a fixed box the points of the
+  // cells beside the pile move with the held nodes' zero velocity (FLIP keeps their velocity:
+  // the held nodes carry no acceleration), so the block rises by less than 0.98 t.
+  auto yaml = [](const std::string& pile) {
+    return R"(
+grid: {origin: [0, 0], extent: [2, 2], cell_size: 0.1}
+scheme: {type: two_phase_double_point, porosity: 0.4, drag: {type: darcy, hydraulic_conductivity: 1.0e-3}}
+bodies:
+  - {name: water, set: liquid, generator: {type: box, min: [0.3, 0.3], max: [1.7, 1.0]},
+     velocity: [0, 1],
+     material: {type: newtonian_fluid, bulk_modulus: 2.0e6, viscosity: 0, density: 1000}}
+boundaries:
+  - )" + pile +
+           R"(
+time: {end: 1}
+)";
+  };
+  for (const std::string pile : {"{type: slip, min: [1, 0], max: [1, 2], directions: [x]}",
+                                 "{type: fixed, min: [1, 0], max: [1, 2]}"}) {
+    auto sim = loam_test::make_simulation<2>(yaml(pile));
+    const auto& P = sim->sets[1].particles;
+    auto mean_y = [&] {
+      double s = 0;
+      for (size_t i = 0; i < P.size(); ++i) s += P.col(P.position, 1)[i];
+      return s / double(P.size());
+    };
+    const double y0 = mean_y();
+    loam_test::advance(*sim, 20);
+    const double rise = mean_y() - y0;
+    double vmin = 1e9, vmax = -1e9, ux = 0;
+    for (size_t i = 0; i < P.size(); ++i) {
+      vmin = std::min(vmin, P.col(P.velocity, 1)[i]);
+      vmax = std::max(vmax, P.col(P.velocity, 1)[i]);
+      ux = std::max(ux, std::fabs(P.col(P.velocity, 0)[i]));
+    }
+    std::printf("%s: v_y in [%.9f, %.9f] m/s, max |v_x| %.2e m/s, rise %.6f m in %.6f s\n",
+                pile.c_str(), vmin, vmax, ux, rise, sim->time);
+    if (pile.find("slip") != std::string::npos) {
+      CHECK(std::fabs(vmin - 1) <= 1e-9);
+      CHECK(std::fabs(vmax - 1) <= 1e-9);
+      CHECK(std::fabs(rise - sim->time) <= 1e-9);
+    } else {
+      CHECK(rise < 0.98 * sim->time);
+    }
+  }
+}
+
+TEST_CASE("slip box and sheet_pile_seepage: located errors", "[piping][cli]") {
+  // A slip box needs directions (a box has no normal); the exit window must span two cell
+  // rows; sheet_pile_seepage needs a 2D or 3D run.
+  loam_test::TempDir dir("piping_bad");
+  const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/seed000_piping.yaml";
+  auto r = loam_test::run_loam("run " + cfg + " --quiet --out " + (dir.path / "a").string() +
+                               " --set 'boundaries.3={type: slip, min: [4, 3], max: [4.25, 8]}'");
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("error: boundaries.3: a box has no normal: give directions (e.g. [x])") !=
+        std::string::npos);
+  auto w = loam_test::run_loam("run " + cfg + " --quiet --out " + (dir.path / "b").string() +
+                               " --set grid.cell_size=0.5");
+  std::printf("%s", w.output.c_str());
+  CHECK(w.exit_code == 2);
+  CHECK(w.output.find("error: verify: the exit window (0.5 m deep) must span two cell rows (1 "
+                      "m)") != std::string::npos);
+  CHECK(!std::filesystem::exists(dir.path / "a"));
+  CHECK(!std::filesystem::exists(dir.path / "b"));
+}
+
+TEST_CASE(
+    "seed 000 piping scene: heads follow the reservoir and the sink, the exit gradient printed",
+    "[piping][scene]") {
+  // configs/seed000_piping.yaml on 0.25 m cells for 3 s (quick variant; docs/verification.md I).
+  // What it asserts: the run ends with no NaN and no lost particle; the upstream head (water over
+  // the sand) rises at the reservoir's 0.25 m/s (least-squares slope over 1 s <= t <= 3 s, within
+  // 10 %) and stays within two particle spacings (0.25 m) below its level 6 + 0.25 t, the
+  // downstream head stays at the sink's 4.5 m within 5 cm; Harr's
+  // critical heads are those of the parameters (i_c = 0.9405, pi d i_c = 2.955 m). What it only
+  // prints: the exit gradient against Harr's, which is not yet right (verification.md I).
+  loam_test::TempDir dir("piping_scene");
+  auto s = loam_test::run_scene("seed000_piping.yaml", dir.path,
+                                "--threads 1 --set grid.cell_size=0.25 --set time.end=3 "
+                                "--set output.every_time=10");
+  const auto& v = s["verify"];
+  const auto& se = v["series"];
+  double worst_up = 0, worst_down = 0, st = 0, sh = 0, stt = 0, sth = 0, n = 0;
+  for (size_t k = 0; k < se["time"].size(); ++k) {
+    const double t = se["time"][k], h = se["head_upstream"][k];
+    if (t < 1.0) continue;
+    worst_up = std::max(worst_up, std::fabs(h - (6 + 0.25 * t)));
+    worst_down = std::max(worst_down, std::fabs(se["head_downstream"][k].get<double>() - 4.5));
+    st += t, sh += h, stt += t * t, sth += t * h, n += 1;
+  }
+  const double rate = (sth - st * sh / n) / (stt - st * st / n);
+  std::printf(
+      "piping (0.25 m cells, 3 s): upstream head rises at %.4f m/s (0.25), off the reservoir "
+      "level by <= %.3f m, downstream off 4.5 m by <= %.3f m; exit gradient %.4f against Harr's "
+      "%.4f at dH = %.3f m "
+      "(exit_gradient_error %+.3f, not asserted); critical head (Harr) %.4f m, (prism) %.4f m; "
+      "%ld steps, %.1f s wall\n",
+      rate, worst_up, worst_down, v["exit_gradient"].get<double>(),
+      se["exit_gradient_harr"].back().get<double>(), v["head_difference"].get<double>(),
+      v["exit_gradient_error"].is_number() ? v["exit_gradient_error"].get<double>() : NAN,
+      v["critical_head_harr"].get<double>(), v["critical_head_prism"].get<double>(),
+      s["steps"].get<long>(), s["wall_seconds"].get<double>());
+  CHECK(rate == Approx(0.25).epsilon(0.1));
+  CHECK(worst_up <= 0.25);
+  CHECK(worst_down <= 0.05);
+  CHECK(v["critical_gradient"].get<double>() == Approx(0.9405).epsilon(1e-12));
+  CHECK(v["critical_head_harr"].get<double>() == Approx(M_PI * 0.9405).epsilon(1e-12));
+  CHECK(v["critical_head_prism"].get<double>() == Approx(0.9405 / 0.354).epsilon(0.003));
+}
