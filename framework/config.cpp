@@ -1,5 +1,6 @@
 #include "config.hpp"
 
+#include <map>
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
@@ -152,6 +153,34 @@ std::string yaml_message(const YAML::Exception& e) {
   return e.msg;
 }
 
+/// Every key given twice in one map, at its second (third, ...) place: yaml-cpp keeps both
+/// pairs but looks up the first, so the later value would be dropped silently.
+void report_duplicate_keys(const YAML::Node& n, const std::string& path, const std::string& file,
+                           int line_offset, int column_offset, Diagnostics& diag) {
+  if (n.IsSequence()) {
+    for (size_t i = 0; i < n.size(); ++i)
+      report_duplicate_keys(n[i], path.empty() ? std::to_string(i) : path + "." + std::to_string(i),
+                            file, line_offset, column_offset, diag);
+    return;
+  }
+  if (!n.IsMap()) return;
+  std::map<std::string, YAML::Mark> seen;
+  for (auto it = n.begin(); it != n.end(); ++it) {
+    const std::string key = it->first.IsScalar() ? it->first.Scalar() : "";
+    const std::string sub = path.empty() ? key : path + "." + key;
+    const YAML::Mark m = it->first.Mark();
+    auto [first, fresh] = seen.emplace(key, m);
+    if (!fresh)
+      diag.error(Location{file, m.line + 1 + line_offset,
+                          m.column + 1 + (m.line == 0 ? column_offset : 0)},
+                 sub,
+                 "duplicate key '" + key + "' (first given at line " +
+                     std::to_string(first->second.line + 1 + line_offset) +
+                     "): each key may appear once in a map");
+    report_duplicate_keys(it->second, sub, file, line_offset, column_offset, diag);
+  }
+}
+
 /// Apply `a.b.c=value` to the YAML tree; list elements are addressed by index (bodies.0.name).
 bool apply_override(YAML::Node root, const std::string& arg, const std::string& label,
                     Diagnostics& diag, std::string& path_out) {
@@ -170,6 +199,9 @@ bool apply_override(YAML::Node root, const std::string& arg, const std::string& 
                "malformed YAML value: " + yaml_message(e));
     return false;
   }
+  const size_t errors = diag.errors().size();
+  report_duplicate_keys(value, path, label, 0, int(eq) + 1, diag);
+  if (diag.errors().size() != errors) return false;
   std::vector<std::string> parts;
   std::stringstream ss(path);
   for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
@@ -233,6 +265,7 @@ bool prepare_tree(YAML::Node& root, const std::string& file,
                   const std::vector<std::string>& overrides, ValidationContext& ctx,
                   Diagnostics& diag, const char* not_a_map) {
   ctx.file = file;
+  report_duplicate_keys(root, "", file, 0, 0, diag);
   if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap()) {
     diag.error(Location{file, root.Mark().line + 1, root.Mark().column + 1}, "", not_a_map);
