@@ -1,7 +1,7 @@
 #include "config.hpp"
 
-#include <map>
 #include <yaml-cpp/yaml.h>
+#include <map>
 
 #include <filesystem>
 #include <fstream>
@@ -175,7 +175,9 @@ void report_duplicate_keys(const YAML::Node& n, const std::string& path, const s
                           m.column + 1 + (m.line == 0 ? column_offset : 0)},
                  sub,
                  "duplicate key '" + key + "' (first given at line " +
-                     std::to_string(first->second.line + 1 + line_offset) +
+                     std::to_string(first->second.line + 1 + line_offset) + ", column " +
+                     std::to_string(first->second.column + 1 +
+                                    (first->second.line == 0 ? column_offset : 0)) +
                      "): each key may appear once in a map");
     report_duplicate_keys(it->second, sub, file, line_offset, column_offset, diag);
   }

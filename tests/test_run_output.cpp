@@ -41,6 +41,17 @@ TEST_CASE("a run writes XDMF frames, probes, history and a complete summary", "[
   // No temporary files are left behind.
   for (const auto& e : std::filesystem::directory_iterator(dir.path))
     CHECK(e.path().extension() != ".tmp");
+  // A run without a reference still has verify: an empty map (the agreed field list).
+  TempDir plain("output_plain");
+  auto p = run_loam(std::string("run ") + LOAM_SOURCE_DIR +
+                    "/configs/vibrating_bar.yaml --quiet --set time.end=0.5 --set "
+                    "'verify=null' --out " + plain.path.string());
+  std::printf("%s", p.output.c_str());
+  REQUIRE(p.exit_code == 0);
+  auto q = nlohmann::json::parse(slurp(plain.path / "summary.json"));
+  REQUIRE(q.contains("verify"));
+  CHECK(q["verify"].is_object());
+  CHECK(q["verify"].empty());
 }
 
 TEST_CASE("an unstable run stops with exit 3 naming step, time, particle and field", "[output]") {
