@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "interrupt.hpp"
 #include "runner.hpp"
 #include "simulation.hpp"
 #include "writer.hpp"
@@ -26,12 +27,14 @@ class CsvFile {
     tmp_ += ".tmp";
     out_.open(tmp_);
     out_.precision(12);
+    register_temporary_file(tmp_.string());  // removed if a second signal stops the run
   }
   std::ofstream& out() { return out_; }
   void close() {
     if (!out_.is_open()) return;
     out_.close();
     fs::rename(tmp_, final_);
+    unregister_temporary_file(tmp_.string());
   }
 
  private:

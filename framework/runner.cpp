@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "interrupt.hpp"
 #include "run.hpp"
 #include "simulation.hpp"
 
@@ -140,6 +141,9 @@ RunResult Run<D>::loop() {
   const double t_end = sim.end_time;
   const double min_dt_ratio = cfg_.params.section("time").real("min_dt_ratio");
   double dt_first = 0;
+  int interrupted = 0;                    // the signal that stopped the run (InterruptGuard)
+  long frame_step = 0, history_step = 0;  // the steps of the last frame and history row
+  InterruptGuard guard;                   // SIGINT, SIGTERM: stop after the current step
   while (sim.time < t_end * (1 - 1e-12) && (opt_.max_steps < 0 || sim.step < opt_.max_steps)) {
     double dt = sim.stable_dt();
     if (dt_first == 0) dt_first = dt;
@@ -176,12 +180,15 @@ RunResult Run<D>::loop() {
       sample_probes(last);
       if (frame_due || last) {
         write_frame("");
+        frame_step = sim.step;
         while (every_time > 0 && next_frame_time <= sim.time * (1 + 1e-9))
           next_frame_time += every_time;
       }
       if ((history_every > 0 && sim.step % history_every == 0) ||
-          (history_every == 0 && (frame_due || last)))
+          (history_every == 0 && (frame_due || last))) {
         write_history();
+        history_step = sim.step;
+      }
     }
     auto now = Clock::now();
     if (!opt_.quiet && std::chrono::duration<double>(now - last_report).count() > 3.0) {
@@ -195,10 +202,17 @@ RunResult Run<D>::loop() {
       last_report = now;
       steps_at_report = sim.step;
     }
+    if ((interrupted = InterruptGuard::requested()) != 0) break;
+  }
+  if (interrupted && files) {  // the state after the last complete step, as a regular frame
+    if (frame_step != sim.step) write_frame("");
+    sample_probes(true);
+    if (history_step != sim.step) write_history();
   }
   double wall = std::chrono::duration<double>(Clock::now() - t0).count();
   res.summary = base_summary();
-  res.summary["status"] = failure.empty() ? "ok" : "unstable";
+  res.summary["status"] = !failure.empty() ? "unstable" : interrupted ? "interrupted" : "ok";
+  if (interrupted) res.summary["interrupted_by"] = signal_name(interrupted);
   res.summary["steps"] = sim.step;
   res.summary["end_time"] = sim.time;
   res.summary["wall_seconds"] = wall;
@@ -248,6 +262,15 @@ RunResult Run<D>::loop() {
     res.summary["failure"] = res.message;
     if (files) write_frame("failed");
   }
+  if (interrupted && failure.empty()) {
+    res.exit_code = 128 + interrupted;
+    res.message = "loam: interrupted by " + signal_name(interrupted) + " at step " +
+                  std::to_string(sim.step) + ", t = " + format_number(sim.time) + " s" +
+                  (files ? ": the last complete step was written as the last frame, with the "
+                           "history, probes and summary.json (status: interrupted)"
+                         : "") +
+                  "\n";
+  }
   if (files) {
     if (!failure.empty()) write_history();
     history_.close();
@@ -260,7 +283,7 @@ RunResult Run<D>::loop() {
     }
     fs::rename(tmp, dir_ / "summary.json");
   }
-  if (!opt_.quiet && failure.empty())
+  if (!opt_.quiet && failure.empty() && !interrupted)
     spdlog::info(
         "done: {} steps, {} particles, {:.3g} s wall, {:.3g} M particle-steps/s on {} thread(s)",
         sim.step, sim.num_particles(), wall,
