@@ -137,6 +137,11 @@ Schema config_schema() {
     n.integer("check_every", "check particles for NaN/inf and leaving the grid every N steps")
         .def("10")
         .min(1);
+    n.boolean("keep_last_good",
+              "keep a copy of the particles at each passed check, written as the last regular "
+              "frame when a later step fails (the failed state goes to a 'failed' frame); false "
+              "saves the copy's memory (about the particles' own)")
+        .def("true");
     s.section("numerics", n, "numerical controls");
   }
   return s;

@@ -29,7 +29,7 @@ extern "C" void on_interrupt(int sig) {
   _exit(128 + sig);
 }
 
-struct sigaction g_previous_int, g_previous_term;
+struct sigaction g_previous_int, g_previous_term, g_previous_xfsz;
 
 }  // namespace
 
@@ -40,11 +40,18 @@ InterruptGuard::InterruptGuard() {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, &g_previous_int);
   sigaction(SIGTERM, &sa, &g_previous_term);
+  // A file size limit (ulimit -f) then fails the write with EFBIG, reported as a WriteError,
+  // instead of killing the process.
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGXFSZ, &ignore, &g_previous_xfsz);
 }
 
 InterruptGuard::~InterruptGuard() {
   sigaction(SIGINT, &g_previous_int, nullptr);
   sigaction(SIGTERM, &g_previous_term, nullptr);
+  sigaction(SIGXFSZ, &g_previous_xfsz, nullptr);
 }
 
 int InterruptGuard::requested() {

@@ -132,6 +132,32 @@ class Particles {
   }
 
   /// Reorder every column so that new[i] = old[order[i]] (after sorting by cell).
+  /// Copy every field into `dst` (the last-good snapshot): the columns in parallel once dst has
+  /// this layout (after the first copy), a plain copy otherwise.
+  void copy_to(Particles& dst, int threads) const {
+    bool same = dst.fields_.size() == fields_.size();
+    for (size_t f = 0; same && f < fields_.size(); ++f)
+      same = dst.fields_[f].allocated == fields_[f].allocated &&
+             dst.fields_[f].data.size() == fields_[f].data.size();
+    if (!same) {
+      dst = *this;
+      return;
+    }
+    std::vector<std::pair<const std::vector<double>*, std::vector<double>*>> columns;
+    for (size_t f = 0; f < fields_.size(); ++f)
+      if (fields_[f].allocated)
+        for (size_t c = 0; c < fields_[f].data.size(); ++c)
+          columns.emplace_back(&fields_[f].data[c], &dst.fields_[f].data[c]);
+    const int nc = int(columns.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int k = 0; k < nc; ++k) *columns[size_t(k)].second = *columns[size_t(k)].first;
+    dst.id = id;
+    dst.material = material;
+    dst.body = body;
+    dst.n_ = n_;
+    for (size_t f = 0; f < fields_.size(); ++f) dst.fields_[f].info = fields_[f].info;
+  }
+
   void permute(const std::vector<uint32_t>& order, int threads = 1) {
     // Columns are independent: permute them in parallel, one scratch column per thread.
     std::vector<std::vector<double>*> columns;

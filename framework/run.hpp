@@ -30,11 +30,22 @@ class CsvFile {
     register_temporary_file(tmp_.string());  // removed if a second signal stops the run
   }
   std::ofstream& out() { return out_; }
-  void close() {
+  /// A failed write (the stream's state after a buffer flush) as WriteError naming the file.
+  void check() {
+    if (!out_) throw WriteError(final_.string(), WriteError::os_reason());
+  }
+  /// Flush, close and rename; with `report`, a failure is a WriteError (the file is renamed
+  /// anyway: the rows written so far are kept).
+  void close(bool report = true) {
     if (!out_.is_open()) return;
+    errno = 0;
     out_.close();
-    fs::rename(tmp_, final_);
+    const bool failed = out_.fail();
+    std::error_code ec;
+    fs::rename(tmp_, final_, ec);
     unregister_temporary_file(tmp_.string());
+    if (report && (failed || ec))
+      throw WriteError(final_.string(), ec ? ec.message() : WriteError::os_reason());
   }
 
  private:
@@ -82,6 +93,8 @@ class Run {
   void write_history();
   bool exchanges_particles() const { return !sim_->sources.empty() || !sim_->sinks.empty(); }
   void write_frame(const std::string& label);
+  /// summary.json, written under a temporary name and renamed (WriteError on failure).
+  void write_summary(const nlohmann::json& summary);
 
   // The loop and summary.json (runner.cpp).
   nlohmann::json base_summary() const;

@@ -228,6 +228,7 @@ void Run<D>::sample_probes(bool force) {
       }
     }
     o << "\n";
+    pr.csv.check();
   }
 }
 
@@ -242,6 +243,27 @@ void Run<D>::write_history() {
   if (exchanges_particles())
     o << "," << sim_->num_particles() << "," << sim_->mass_created << "," << sim_->mass_removed;
   o << "\n";
+  history_.check();
+}
+
+template <int D>
+void Run<D>::write_summary(const nlohmann::json& summary) {
+  const fs::path file = dir_ / "summary.json", tmp = dir_ / "summary.json.tmp";
+  errno = 0;
+  bool written;
+  {
+    std::ofstream js(tmp);
+    js << summary.dump(2) << "\n";
+    js.flush();
+    written = bool(js);
+  }
+  if (!written) {
+    const std::string reason = WriteError::os_reason();
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw WriteError(file.string(), reason);
+  }
+  fs::rename(tmp, file);
 }
 
 template <int D>

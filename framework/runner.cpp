@@ -119,6 +119,7 @@ nlohmann::json Run<D>::base_summary() const {
 template <int D>
 RunResult Run<D>::loop() {
   RunResult res;
+  InterruptGuard guard;  // SIGINT, SIGTERM: stop after the current step; SIGXFSZ ignored
   Simulation<D>& sim = *sim_;
   const Params& out = cfg_.params.section("output");
   const long every_steps = out.has("every_steps") ? long(out.integer("every_steps")) : 0;
@@ -127,12 +128,25 @@ RunResult Run<D>::loop() {
   const long history_every = long(out.integer("history_every"));
   double next_frame_time = every_time;
   const bool files = opt_.write_output;
-  if (files) {
-    open_outputs();
-    write_frame("");
-    write_history();
-    sample_probes(true);
-  }
+  // A file that cannot be written (WriteError, a failed rename) stops the run with exit 4.
+  std::string write_error;
+  auto guarded = [&](auto&& write) {
+    if (!write_error.empty()) return;
+    try {
+      write();
+    } catch (const WriteError& e) {
+      write_error = e.what();
+    } catch (const fs::filesystem_error& e) {
+      write_error = "cannot write " + e.path1().string() + ": " + e.code().message();
+    }
+  };
+  if (files)
+    guarded([&] {
+      open_outputs();
+      write_frame("");
+      write_history();
+      sample_probes(true);
+    });
   Energies e0 = sim.energies();
   double dt_min = 1e300, dt_max = 0;
   std::string failure;
@@ -141,10 +155,11 @@ RunResult Run<D>::loop() {
   const double t_end = sim.end_time;
   const double min_dt_ratio = cfg_.params.section("time").real("min_dt_ratio");
   double dt_first = 0;
-  int interrupted = 0;                    // the signal that stopped the run (InterruptGuard)
-  long frame_step = 0, history_step = 0;  // the steps of the last frame and history row
-  InterruptGuard guard;                   // SIGINT, SIGTERM: stop after the current step
-  while (sim.time < t_end * (1 - 1e-12) && (opt_.max_steps < 0 || sim.step < opt_.max_steps)) {
+  int interrupted = 0;                           // the signal that stopped the run (InterruptGuard)
+  long frame_step = 0, history_step = 0;         // the steps of the last frame and history row
+  if (sim.keep_last_good) sim.save_last_good();  // t = 0: it passed the set-up checks
+  while (write_error.empty() && sim.time < t_end * (1 - 1e-12) &&
+         (opt_.max_steps < 0 || sim.step < opt_.max_steps)) {
     double dt = sim.stable_dt();
     if (dt_first == 0) dt_first = dt;
     if (dt < min_dt_ratio * dt_first) {
@@ -176,20 +191,22 @@ RunResult Run<D>::loop() {
       break;
     }
     if (sim.reference) sim.reference->sample(sim);
-    if (files) {
-      sample_probes(last);
-      if (frame_due || last) {
-        write_frame("");
-        frame_step = sim.step;
-        while (every_time > 0 && next_frame_time <= sim.time * (1 + 1e-9))
-          next_frame_time += every_time;
-      }
-      if ((history_every > 0 && sim.step % history_every == 0) ||
-          (history_every == 0 && (frame_due || last))) {
-        write_history();
-        history_step = sim.step;
-      }
-    }
+    if (files)
+      guarded([&] {
+        sample_probes(last);
+        if (frame_due || last) {
+          write_frame("");
+          frame_step = sim.step;
+          while (every_time > 0 && next_frame_time <= sim.time * (1 + 1e-9))
+            next_frame_time += every_time;
+        }
+        if ((history_every > 0 && sim.step % history_every == 0) ||
+            (history_every == 0 && (frame_due || last))) {
+          write_history();
+          history_step = sim.step;
+        }
+      });
+    if (!write_error.empty()) break;
     auto now = Clock::now();
     if (!opt_.quiet && std::chrono::duration<double>(now - last_report).count() > 3.0) {
       double el = std::chrono::duration<double>(now - t0).count();
@@ -204,11 +221,12 @@ RunResult Run<D>::loop() {
     }
     if ((interrupted = InterruptGuard::requested()) != 0) break;
   }
-  if (interrupted && files) {  // the state after the last complete step, as a regular frame
-    if (frame_step != sim.step) write_frame("");
-    sample_probes(true);
-    if (history_step != sim.step) write_history();
-  }
+  if (interrupted && files)  // the state after the last complete step, as a regular frame
+    guarded([&] {
+      if (frame_step != sim.step) write_frame("");
+      sample_probes(true);
+      if (history_step != sim.step) write_history();
+    });
   double wall = std::chrono::duration<double>(Clock::now() - t0).count();
   res.summary = base_summary();
   res.summary["status"] = !failure.empty() ? "unstable" : interrupted ? "interrupted" : "ok";
@@ -255,12 +273,27 @@ RunResult Run<D>::loop() {
   }
   if (!failure.empty()) {
     res.exit_code = 3;
-    res.message =
-        "loam: error: unstable run at step " + std::to_string(sim.step) +
-        ", t = " + format_number(sim.time) + " s: " + failure +
-        (files ? "; the state at detection was written as the last frame ('failed')" : "") + "\n";
+    std::string written;
+    if (files) {
+      // The last state that passed the check as the last regular frame (unless it is one
+      // already), then the state at detection as 'failed'.
+      const auto& good = sim.last_good;
+      if (good.step >= 0) {
+        if (good.step != frame_step) {
+          sim.swap_last_good();
+          guarded([&] { write_frame(""); });
+          sim.swap_last_good();
+        }
+        res.summary["last_good"] = {{"step", good.step}, {"time", good.time}};
+        written = "; the last state that passed the check (step " + std::to_string(good.step) +
+                  ", t = " + format_number(good.time) + " s) is the last regular frame";
+      }
+      guarded([&] { write_frame("failed"); });
+      written += "; the state at detection was written as the frame labelled 'failed'";
+    }
+    res.message = "loam: error: unstable run at step " + std::to_string(sim.step) +
+                  ", t = " + format_number(sim.time) + " s: " + failure + written + "\n";
     res.summary["failure"] = res.message;
-    if (files) write_frame("failed");
   }
   if (interrupted && failure.empty()) {
     res.exit_code = 128 + interrupted;
@@ -272,16 +305,35 @@ RunResult Run<D>::loop() {
                   "\n";
   }
   if (files) {
-    if (!failure.empty()) write_history();
-    history_.close();
-    for (auto& pr : probes_) pr.csv.close();
-    writer_->close();
-    fs::path tmp = dir_ / "summary.json.tmp";
-    {
-      std::ofstream js(tmp);
-      js << res.summary.dump(2) << "\n";
+    guarded([&] {
+      if (!failure.empty()) write_history();
+      history_.close();
+      for (auto& pr : probes_) pr.csv.close();
+      writer_->close();
+    });
+    if (!write_error.empty()) {
+      // Keep what was written: the history and probe rows so far are renamed to their names.
+      history_.close(false);
+      for (auto& pr : probes_) pr.csv.close(false);
+      res.exit_code = 4;
+      res.message = "loam: error: " + write_error + "; the run stopped at step " +
+                    std::to_string(sim.step) + ", t = " + format_number(sim.time) +
+                    " s (the frames, history and probes written before are intact)\n";
+      res.summary["status"] = "write_failed";
+      res.summary["write_error"] = write_error;
     }
-    fs::rename(tmp, dir_ / "summary.json");
+    if (write_error.empty()) {
+      guarded([&] { write_summary(res.summary); });
+      if (!write_error.empty()) {  // only summary.json failed
+        res.exit_code = 4;
+        res.message += "loam: error: " + write_error + "\n";
+      }
+    } else {
+      try {  // the summary with status write_failed, if the disk still takes it
+        write_summary(res.summary);
+      } catch (const std::exception&) {
+      }
+    }
   }
   if (!opt_.quiet && failure.empty() && !interrupted)
     spdlog::info(

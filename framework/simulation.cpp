@@ -37,9 +37,57 @@ bool Simulation<D>::advance(double step_dt, bool check) {
   if (!failure.empty()) return false;
   exchange_particles();
   // Check before sorting: the sort must not see non-finite positions.
-  if ((check || step % check_every == 0) && !check_particles(failure)) return false;
+  if (check || step % check_every == 0) {
+    bool ok = true;
+    timed("check_particles", [&] { ok = check_particles(failure); });
+    if (!ok) return false;
+    if (keep_last_good) timed("last_good_copy", [&] { save_last_good(); });
+  }
   timed("partition", [&] { maintain_partition(); });
   return true;
+}
+
+template <int D>
+void Simulation<D>::check_grid(const GridUpdate& u) {
+  const long n = long(grid.num_nodes);
+  for (int k = 0; k < u.count; ++k) {
+    const NodalVector& v = u.phases[size_t(k)].velocity;
+    const NodalVector& a = u.phases[size_t(k)].acceleration;
+    double sum = 0;
+#pragma omp parallel for reduction(+ : sum) schedule(static) num_threads(threads)
+    for (long i = 0; i < n; ++i)
+      for (int d = 0; d < D; ++d) sum += 0.0 * v.at(size_t(i), d) + 0.0 * a.at(size_t(i), d);
+    if (sum == 0.0) continue;
+    for (size_t i = 0; i < grid.num_nodes; ++i)
+      for (int d = 0; d < D; ++d)
+        for (const auto& [what, value] :
+             {std::pair<const char*, double>{"velocity", v.at(i, d)}, {"acceleration", a.at(i, d)}})
+          if (!std::isfinite(value)) {
+            std::string at;
+            for (int c = 0; c < D; ++c)
+              at += (c ? ", " : "") + format_number(grid.node_coord(i, c));
+            failure = "grid node " + std::to_string(i) + " at (" + at + ")" +
+                      (u.count > 1 ? (k == 0 ? " (solid)" : " (water)") : "") + ": " + what + "." +
+                      std::string(1, char('x' + d)) + " = " + format_number(value) +
+                      " after the grid update";
+            return;
+          }
+  }
+}
+
+template <int D>
+void Simulation<D>::save_last_good() {
+  last_good.time = time;
+  last_good.step = step;
+  last_good.sets.resize(sets.size());
+  for (size_t k = 0; k < sets.size(); ++k) sets[k].particles.copy_to(last_good.sets[k], threads);
+}
+
+template <int D>
+void Simulation<D>::swap_last_good() {
+  std::swap(time, last_good.time);
+  std::swap(step, last_good.step);
+  for (size_t k = 0; k < sets.size(); ++k) std::swap(sets[k].particles, last_good.sets[k]);
 }
 
 template <int D>

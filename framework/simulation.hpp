@@ -126,7 +126,7 @@ class Simulation {
   ///     in the remaining free subspace; several friction faces scale the same free vector, so
   ///     their order does not matter either);
   ///  4. the hydraulic conditions on the water.
-  void constrain_update(const GridUpdate& update) const {
+  void constrain_update(const GridUpdate& update) {
     GridUpdate u = update;
     for (int k = 0; k < u.count; ++k) {
       held_[size_t(k)].clear(grid.num_nodes);
@@ -141,7 +141,27 @@ class Simulation {
       if (!b->hydraulic()) b->coulomb_update(u);
     for (const auto& b : boundaries)
       if (b->hydraulic()) b->constrain_grid_update(u);
+    timed("check_grid", [&] { check_grid(u); });
   }
+  /// NaN or inf on the grid is caught in the step it appears (before the transfer to the
+  /// particles spreads it): one pass over each phase's nodal velocity and acceleration after the
+  /// conditions, sum of 0 * value (NaN for any non-finite value, 0 otherwise), then the first
+  /// such node is named in `failure`.
+  void check_grid(const GridUpdate& u);
+
+  /// The state of the last step that passed the stability check (numerics.keep_last_good): the
+  /// runner writes it as the last regular frame when a later step fails.
+  struct GoodState {
+    double time = 0;
+    long step = -1;
+    std::vector<Particles<D>> sets;
+  };
+  GoodState last_good;
+  bool keep_last_good = true;
+  void save_last_good();
+  /// Exchange the particles and time of the last good state with the current ones (twice:
+  /// back).
+  void swap_last_good();
   /// The material stress update of one block [b, b + count) (one material per block), with
   /// its velocity gradient L in block layout (MaterialBatch).
   void update_block_stress(ParticleSet<D>& set, size_t b, int count, double dt, const double* L) {

@@ -1,9 +1,25 @@
 #pragma once
 // Output writer plugin interface: one frame per output time, into the run's output directory.
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace loam {
+
+/// A file of the run that could not be written (disk full, a file size limit, the directory
+/// removed or read-only): the run stops with exit code 4 and this message, naming the file and
+/// the operating system's reason (strerror of errno at the failure).
+struct WriteError : std::runtime_error {
+  std::string file;
+  WriteError(const std::string& f, const std::string& reason)
+      : std::runtime_error("cannot write " + f + ": " + reason), file(f) {}
+  /// The reason from errno (set by the failing call), or `fallback` if errno is 0.
+  static std::string os_reason(const char* fallback = "the write failed") {
+    return errno ? std::string(std::strerror(errno)) : std::string(fallback);
+  }
+};
 
 template <int D>
 class Simulation;

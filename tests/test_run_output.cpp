@@ -1,10 +1,13 @@
 // Run contract: output files, probes, the unstable-run stop (exit 3), overrides in the summary.
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <fstream>
 #include <regex>
 #include <sstream>
 
 #include "cli.hpp"
+#include "framework/boundary.hpp"
+#include "sim_helpers.hpp"
 
 using loam_test::run_loam;
 using loam_test::slurp;
@@ -45,7 +48,8 @@ TEST_CASE("a run writes XDMF frames, probes, history and a complete summary", "[
   TempDir plain("output_plain");
   auto p = run_loam(std::string("run ") + LOAM_SOURCE_DIR +
                     "/configs/vibrating_bar.yaml --quiet --set time.end=0.5 --set "
-                    "'verify=null' --out " + plain.path.string());
+                    "'verify=null' --out " +
+                    plain.path.string());
   std::printf("%s", p.output.c_str());
   REQUIRE(p.exit_code == 0);
   auto q = nlohmann::json::parse(slurp(plain.path / "summary.json"));
@@ -129,4 +133,113 @@ TEST_CASE("a collapsing time step stops the run early with the cause (time.min_d
   auto s = nlohmann::json::parse(slurp(dir.path / "out" / "summary.json"));
   CHECK(s["status"] == "unstable");
   CHECK(s["steps"].get<long>() < 1000);
+}
+
+TEST_CASE("a non-finite nodal value stops the step it appears in, naming the node",
+          "[output][stability]") {
+  // Simulation::check_grid runs at the end of every grid update (constrain_update): a NaN or
+  // inf in any phase's nodal velocity or acceleration is reported with the node, its position,
+  // the phase and the component, before the transfer to the particles spreads it.
+  auto sim = loam_test::make_simulation<2>(R"(
+grid: {origin: [0, 0], extent: [1, 1], cell_size: 0.25}
+bodies:
+  - {name: block, generator: {type: box, min: [0, 0], max: [1, 1]},
+     material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 1000}}
+time: {end: 1}
+)");
+  const size_t n = sim->grid.num_nodes;
+  std::vector<double> v(2 * n, 0.0), a(2 * n, 0.0), m(n, 1.0);
+  loam::GridUpdate u;
+  u.phases[0] = {loam::NodalVector{v.data(), 2, 0}, loam::NodalVector{a.data(), 2, 0},
+                 loam::NodalVector{m.data(), 1, 0}};
+  sim->check_grid(u);
+  CHECK(sim->failure.empty());
+  v[2 * 7 + 1] = std::nan("");
+  sim->check_grid(u);
+  std::printf("%s\n", sim->failure.c_str());
+  CHECK(sim->failure == "grid node 7 at (0.5, 0.25): velocity.y = nan after the grid update");
+  sim->failure.clear();
+  v[2 * 7 + 1] = 0;
+  a[2 * 3] = -INFINITY;
+  sim->check_grid(u);
+  std::printf("%s\n", sim->failure.c_str());
+  CHECK(sim->failure == "grid node 3 at (0.75, 0): acceleration.x = -inf after the grid update");
+}
+
+TEST_CASE("an unstable run writes the last state that passed the check as its last frame",
+          "[output][stability]") {
+  // A time step 40x above the CFL limit, checked every step: the column leaves the grid at step
+  // 4. The last regular frame is the state after step 3 (the last that passed), finite and at
+  // t = 0.012 s; the state at detection is the frame labelled 'failed'; summary.json and the
+  // message name the good state.
+  TempDir dir("last_good");
+  auto r = run_loam(std::string("run ") + LOAM_SOURCE_DIR +
+                    "/configs/elastic_column_1d.yaml --quiet --set time.dt=0.004 --set "
+                    "numerics.check_every=1 --out " +
+                    dir.path.string());
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 3);
+  CHECK(r.output.find("the last state that passed the check (step 3, t = 0.012 s) is the last "
+                      "regular frame; the state at detection was written as the frame labelled "
+                      "'failed'") != std::string::npos);
+  auto s = nlohmann::json::parse(slurp(dir.path / "summary.json"));
+  CHECK(s["last_good"]["step"] == 3);
+  CHECK(s["last_good"]["time"].get<double>() == Approx(0.012));
+  const std::string xdmf = slurp(dir.path / "particles.xdmf");
+  CHECK(xdmf.find("particles_000001.h5") != std::string::npos);
+  CHECK(xdmf.find("<Time Value=\"0.012") != std::string::npos);
+  const auto x = loam_test::read_frame_doubles(dir.path / "particles_000001.h5", "position");
+  REQUIRE(!x.empty());
+  for (double xi : x) CHECK(std::isfinite(xi));
+  double x_max = 0;
+  for (size_t i = 0; i < x.size(); i += 3) x_max = std::max(x_max, x[i]);
+  CHECK(x_max <= 10.5);  // inside the grid: the state before the particle left
+  CHECK(std::filesystem::exists(dir.path / "particles_000002_failed.h5"));
+}
+
+TEST_CASE("a file that cannot be written stops the run with exit 4, naming it, the rest intact",
+          "[output][write_failure]") {
+  // A file size limit of 64 KiB (ulimit -f; works for root too, unlike a read-only directory):
+  // the XDMF index outgrows it after ~58 frames. Exit 4, the message names the file and the
+  // OS error; the frames the index lists, the history and summary.json (status write_failed)
+  // are complete; no .tmp file is left.
+  TempDir dir("write_failure");
+  const std::string cmd = std::string("bash -c 'ulimit -f 64; ") + LOAM_EXE + " run " +
+                          LOAM_SOURCE_DIR +
+                          "/configs/vibrating_bar.yaml --quiet --threads 1 --set time.end=1e5 "
+                          "--set \"probes=[]\" --out " +
+                          dir.path.string() + " 2>" + dir.path.string() + ".err; echo $? > " +
+                          dir.path.string() + ".rc'";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  int code = -1;
+  std::ifstream(dir.path.string() + ".rc") >> code;
+  const std::string err = slurp(dir.path.string() + ".err");
+  std::printf("exit %d: %s", code, err.c_str());
+  CHECK(code == 4);
+  CHECK(err.rfind("loam: error: cannot write " + (dir.path / "particles.xdmf").string() +
+                      ": File too large; the run stopped at step ",
+                  0) == 0);
+  CHECK(err.find("(the frames, history and probes written before are intact)") !=
+        std::string::npos);
+  auto s = nlohmann::json::parse(slurp(dir.path / "summary.json"));
+  CHECK(s["status"] == "write_failed");
+  const std::string xdmf = slurp(dir.path / "particles.xdmf");
+  long frames = 0;
+  for (size_t p = 0; (p = xdmf.find("<Time Value", p)) != std::string::npos; ++p) ++frames;
+  CHECK(frames >= 10);
+  for (long f = 0; f < frames; ++f) {
+    char name[64];
+    std::snprintf(name, sizeof name, "particles_%06ld.h5", f);
+    CHECK(!loam_test::read_frame_doubles(dir.path / name, "position").empty());
+  }
+  std::ifstream hist(dir.path / "history.csv");
+  std::string line, last;
+  long rows = 0;
+  while (std::getline(hist, line)) last = line, ++rows;
+  CHECK(rows > 1);
+  CHECK(std::stol(last.substr(0, last.find(','))) <= s["steps"].get<long>());
+  for (const auto& e : std::filesystem::directory_iterator(dir.path))
+    CHECK(e.path().extension() != ".tmp");
+  std::filesystem::remove(dir.path.string() + ".rc");
+  std::filesystem::remove(dir.path.string() + ".err");
 }

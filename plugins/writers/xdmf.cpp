@@ -29,6 +29,7 @@ class Xdmf : public Writer<D> {
   void open(const std::string& dir, Simulation<D>&, const std::vector<int>& fields) override {
     dir_ = dir;
     fields_ = fields;
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // failures are reported as WriteError
   }
 
   void write(Simulation<D>& sim, const std::string& label) override {
@@ -55,6 +56,7 @@ class Xdmf : public Writer<D> {
   std::vector<int> fields_;
   std::vector<std::vector<Frame>> frames_;  // per set
   bool with_grid_;
+  bool ok_ = true;  // every dataset of the frame being written was written
 
   /// One frame of set s: <set>_NNNNNN[_label].h5 with the particles (and, in the first set's
   /// file, the grid), then the set's index <set>.xdmf.
@@ -68,7 +70,10 @@ class Xdmf : public Writer<D> {
     std::filesystem::path file = std::filesystem::path(dir_) / name;
     std::filesystem::path tmp = file;
     tmp += ".tmp";
+    errno = 0;
     hid_t f = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    if (f < 0) fail(file, tmp);
+    ok_ = true;
     Frame fr{name, sim.time, sim.step, n, {}, 0, {}};
     write_columns(f, "position", P, P.position, 3);
     std::vector<int> ids(n);
@@ -88,24 +93,34 @@ class Xdmf : public Writer<D> {
     }
     const bool grid = with_grid_ && s == 0;
     if (grid) write_grid(f, sim, fr);
-    H5Fclose(f);
+    const bool closed = H5Fclose(f) >= 0;
+    if (!ok_ || !closed) fail(file, tmp);
     std::filesystem::rename(tmp, file);
     frames_[s].push_back(fr);
     write_index(set.name, frames_[s], grid);
   }
 
-  static void write_dataset(hid_t f, const std::string& name, const void* data, size_t n, int width,
-                            hid_t type) {
+  /// The frame's temporary file is removed and the failure reported (WriteError).
+  [[noreturn]] static void fail(const std::filesystem::path& file,
+                                const std::filesystem::path& tmp) {
+    const std::string reason = WriteError::os_reason("HDF5 could not write the file");
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw WriteError(file.string(), reason);
+  }
+
+  void write_dataset(hid_t f, const std::string& name, const void* data, size_t n, int width,
+                     hid_t type) {
     hsize_t dims[2] = {hsize_t(n), hsize_t(width)};
     hid_t space = H5Screate_simple(width == 1 ? 1 : 2, dims, nullptr);
     hid_t ds = H5Dcreate2(f, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (n > 0) H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
-    H5Dclose(ds);
+    if (ds < 0 || (n > 0 && H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0))
+      ok_ = false;
+    if (ds >= 0) H5Dclose(ds);
     H5Sclose(space);
   }
 
-  static void write_columns(hid_t f, const std::string& name, const Particles<D>& P, int h,
-                            int width) {
+  void write_columns(hid_t f, const std::string& name, const Particles<D>& P, int h, int width) {
     const size_t n = P.size();
     const int nc = P.info(h).components;
     std::vector<double> buf(n * size_t(width), 0.0);
@@ -175,9 +190,19 @@ class Xdmf : public Writer<D> {
     std::filesystem::path file = std::filesystem::path(dir_) / (set + ".xdmf");
     std::filesystem::path tmp = file;
     tmp += ".tmp";
+    errno = 0;
+    bool written;
     {
       std::ofstream o(tmp);
       o << x.str();
+      o.flush();
+      written = bool(o);
+    }
+    if (!written) {
+      const std::string reason = WriteError::os_reason();
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      throw WriteError(file.string(), reason);
     }
     std::filesystem::rename(tmp, file);
   }
