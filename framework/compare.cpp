@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "diagnostics.hpp"
+#include "interrupt.hpp"
 #include "params.hpp"
 #include "process.hpp"
 
@@ -199,13 +200,19 @@ int run_compare(const CompareOptions& opt) {
   }
 
   const std::string exe = fs::read_symlink("/proc/self/exe").string();
+  // SIGINT / SIGTERM (Ctrl-C reaches the running variant too, which stops cleanly with status
+  // interrupted): the sweep stops after that variant, writes compare.csv and exits 128 +
+  // signal; the same command later resumes it, re-running the interrupted variant.
+  InterruptGuard guard;
+  int interrupted = 0;
   for (size_t i = 0; i < variants.size(); ++i) {
     Variant& v = variants[i];
     fs::path dir = out / "variants" / v.name;
     std::string label =
         "[" + std::to_string(i + 1) + "/" + std::to_string(variants.size()) + "] " + v.name;
     nlohmann::json previous;
-    if (load_summary(dir / "summary.json", previous)) {
+    if (load_summary(dir / "summary.json", previous) &&
+        previous.value("status", "") != "interrupted") {
       v.summary = previous;
       v.status = previous["status"].get<std::string>();
       if (previous.contains("failure")) v.message = previous["failure"].get<std::string>();
@@ -222,6 +229,17 @@ int run_compare(const CompareOptions& opt) {
     int code = run_command(cmd, output);
     while (!output.empty() && output.back() == '\n') output.pop_back();
     load_summary(dir / "summary.json", v.summary);
+    if (code == 130 || code == 143 || InterruptGuard::requested()) {
+      interrupted = InterruptGuard::requested() ? InterruptGuard::requested() : code - 128;
+      v.status = "interrupted";
+      v.message = output;
+      write_csv(out / "compare.csv", axes, variants);
+      spdlog::warn(
+          "{}: interrupted by {}; compare.csv has the variants done so far; the same "
+          "command resumes the sweep (the interrupted variant runs again)",
+          label, signal_name(interrupted));
+      return 128 + interrupted;
+    }
     v.status = code == 0 ? "ok" : code == 2 ? "invalid" : code == 3 ? "unstable" : "error";
     if (code != 0) {
       v.message = output.empty() ? "exit code " + std::to_string(code) : output;

@@ -92,3 +92,48 @@ TEST_CASE("loam compare rejects a bad sweep file with a located error", "[compar
                                        "list of values") != std::string::npos);
   CHECK_FALSE(std::filesystem::exists(dir.path / "out"));
 }
+
+TEST_CASE("loam compare stops cleanly on SIGINT and the same command resumes the sweep",
+          "[compare][interrupt]") {
+  // Ctrl-C reaches the whole process group: the running variant stops with status
+  // interrupted (exit 130) and the sweep after it, writing compare.csv, exit 130. Run again,
+  // the interrupted variant is not "already done": it runs again, and the sweep completes.
+  TempDir dir("compare_interrupt");
+  std::filesystem::create_directories(dir.path);
+  const auto sweep = dir.path / "sweep.yaml";
+  std::ofstream(sweep) << "base: " << LOAM_SOURCE_DIR << "/configs/vibrating_bar.yaml\n"
+                       << "set: [time.end=3000, output.every_time=1000]\n"
+                       << "axes:\n  scheme.flip: [1.0, 0.99]\nthreads: 1\n";
+  const auto out = dir.path / "out";
+  const auto rc = dir.path / "rc";
+  const std::string cmd = "bash -c 'set -m; " + std::string(LOAM_EXE) + " compare " +
+                          sweep.string() + " --out " + out.string() +
+                          " >/dev/null 2>&1 & pid=$!; sleep 1; kill -INT -$pid; wait $pid; "
+                          "echo $? > " +
+                          rc.string() + "'";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  int code = -1;
+  std::ifstream(rc) >> code;
+  int interrupted = 0, done = 0;
+  for (const auto& e : std::filesystem::directory_iterator(out / "variants")) {
+    if (!std::filesystem::exists(e.path() / "summary.json")) continue;
+    auto s = nlohmann::json::parse(loam_test::slurp(e.path() / "summary.json"));
+    (s["status"] == "interrupted" ? interrupted : done) += 1;
+  }
+  std::printf("compare after SIGINT: exit %d, %d variant(s) interrupted, %d done\n", code,
+              interrupted, done);
+  CHECK(code == 130);
+  CHECK(interrupted == 1);
+  CHECK(done == 0);
+  CHECK(std::filesystem::exists(out / "compare.csv"));
+  auto again = run_loam("compare " + sweep.string() + " --out " + out.string());
+  INFO(again.output);
+  CHECK(again.exit_code == 0);
+  CHECK(again.output.find("already done") == std::string::npos);
+  auto rows = read_csv(out / "compare.csv");
+  REQUIRE(rows.size() == 3);
+  const auto& h = rows[0];
+  const size_t status = size_t(std::find(h.begin(), h.end(), "status") - h.begin());
+  CHECK(rows[1][status] == "ok");
+  CHECK(rows[2][status] == "ok");
+}
