@@ -113,6 +113,17 @@ Schema config_schema() {
               "write energies and momentum to history.csv every N steps (0: at frames)")
         .def("0")
         .min(0);
+    Schema c;
+    c.integer("every_steps", "write a checkpoint every N steps").min(1);
+    c.real("every_wall_seconds", "s", "write a checkpoint every T seconds of wall time").positive();
+    c.integer("keep", "how many of the newest checkpoints to keep (default 2)").min(1);
+    c.check([](const Params& p, Diagnostics& d) {
+      if (p.has("keep") && !p.has("every_steps") && !p.has("every_wall_seconds"))
+        d.error(p.where(), p.path(), "give every_steps or every_wall_seconds (or both)");
+    });
+    o.section("checkpoint", c,
+              "checkpoints (checkpoint_<step>.h5 in the output directory): loam run --resume "
+              "DIR continues from the newest, bit for bit");
     s.section("output", o, "output of particle frames");
   }
   {

@@ -23,6 +23,9 @@ int main(int argc, char** argv) {
   run->add_option("--set", run_opt.overrides, "override a key: path.to.key=value (repeatable)")
       ->allow_extra_args(false);
   run->add_option("--out", run_opt.out_dir, "output directory (default results/<config name>)");
+  run->add_option("--resume", run_opt.resume,
+                  "continue from a checkpoint: the run's output directory (its newest valid "
+                  "checkpoint_*.h5) or one checkpoint file; the output goes on there");
   run->add_flag("--overwrite", run_opt.overwrite,
                 "replace the results in a non-empty output directory");
   run->add_option("--threads", run_opt.threads, "OpenMP threads (default: all cores)")

@@ -26,6 +26,11 @@ class Reference {
   /// A time series the reference recorded (column name, values; the first column is usually
   /// the time), or empty: written to summary.json (verify.series) and to verify.csv.
   virtual std::vector<std::pair<std::string, std::vector<double>>> series() const { return {}; }
+  /// Checkpoints (output.checkpoint): the plugin's accumulated state as doubles, restored
+  /// bit for bit on --resume. false: it has none implemented yet, and a checkpointed run with
+  /// it is refused (a silently lost state would break the resumed run's results).
+  virtual bool save_state(std::vector<double>&) const { return false; }
+  virtual void restore_state(const std::vector<double>&) {}
 };
 
 }  // namespace loam

@@ -30,6 +30,21 @@ class CsvFile {
     register_temporary_file(tmp_.string());  // removed if a second signal stops the run
   }
   std::ofstream& out() { return out_; }
+  /// Open for a resumed run: the rows of the existing file whose first column (the step) is at
+  /// most max_step, with its header, are copied into the temporary file, which goes on.
+  void open_resume(const fs::path& path, long max_step) {
+    std::vector<std::string> keep;
+    {
+      std::ifstream in(path);
+      std::string line;
+      if (std::getline(in, line)) keep.push_back(line);
+      while (std::getline(in, line))
+        if (!line.empty() && std::stol(line.substr(0, line.find(','))) <= max_step)
+          keep.push_back(line);
+    }
+    open(path);
+    for (const auto& l : keep) out_ << l << "\n";
+  }
   /// A failed write (the stream's state after a buffer flush) as WriteError naming the file.
   void check() {
     if (!out_) throw WriteError(final_.string(), WriteError::os_reason());
@@ -84,11 +99,29 @@ class Run {
   int displacement_ = -1, initial_position_ = -1;
   long frames_ = 0;
 
+  /// What the time loop carries from step to step besides the simulation (checkpointed).
+  struct LoopState {
+    double next_frame_time = 0, dt_first = 0, dt_min = 1e300, dt_max = 0;
+    long frame_step = 0, history_step = 0;
+    Energies e0;
+  };
+  LoopState ls_;
+  // Checkpoints (output.checkpoint; runner.cpp).
+  long checkpoint_every_ = 0;
+  double checkpoint_wall_ = 0;
+  int checkpoint_keep_ = 2;
+  std::vector<fs::path> checkpoints_;  // oldest first
+  fs::path resume_file_;               // --resume: the checkpoint to continue from
+  std::string checkpoint_problem() const;
+  void write_checkpoint();
+  void restore_checkpoint();
+  std::string find_resume_checkpoint();
+
   // Output (run_output.cpp).
   void check_outputs(Diagnostics& diag);
   std::string prepare_directory();
   void refresh_derived();
-  void open_outputs();
+  void open_outputs(long resume_step = -1);
   void sample_probes(bool force);
   void write_history();
   bool exchanges_particles() const { return !sim_->sources.empty() || !sim_->sinks.empty(); }

@@ -168,9 +168,14 @@ void Run<D>::refresh_derived() {
 }
 
 template <int D>
-void Run<D>::open_outputs() {
+void Run<D>::open_outputs(long resume_step) {
   writer_ = Registry::instance().create<Writer, D>(cfg_.params.section("output").section("writer"));
   writer_->open(dir_.string(), *sim_, frame_fields_);
+  if (resume_step >= 0) {  // the files go on from the checkpoint's step
+    history_.open_resume(dir_ / "history.csv", resume_step);
+    for (auto& pr : probes_) pr.csv.open_resume(dir_ / ("probe_" + pr.name + ".csv"), resume_step);
+    return;
+  }
   history_.open(dir_ / "history.csv");
   history_.out() << "step,time,dt,kinetic_energy,strain_energy,gravity_energy,total_energy";
   for (int d = 0; d < D; ++d)

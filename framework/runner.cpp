@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "checkpoint.hpp"
 #include "interrupt.hpp"
 #include "run.hpp"
 #include "simulation.hpp"
@@ -68,6 +69,31 @@ RunResult Run<D>::execute(bool check_only) {
     res.summary = base_summary();
     return res;
   }
+  const Params& output = cfg_.params.section("output");
+  if (output.has("checkpoint") && (output.section("checkpoint").has("every_steps") ||
+                                   output.section("checkpoint").has("every_wall_seconds"))) {
+    const Params& c = output.section("checkpoint");
+    checkpoint_every_ = c.has("every_steps") ? long(c.integer("every_steps")) : 0;
+    checkpoint_wall_ = c.has("every_wall_seconds") ? c.real("every_wall_seconds") : 0;
+    checkpoint_keep_ = c.has("keep") ? int(c.integer("keep")) : 2;
+    const std::string problem = checkpoint_problem();
+    if (!problem.empty()) {
+      res.exit_code = 2;
+      Diagnostics d;
+      d.error(c.where(), c.path(), problem);
+      res.message = d.format();
+      return res;
+    }
+  }
+  if (!opt_.resume.empty()) {
+    const std::string err = find_resume_checkpoint();
+    if (!err.empty()) {
+      res.exit_code = 2;
+      res.message = "loam: error: " + err + "\n";
+      return res;
+    }
+    return loop();
+  }
   if (opt_.write_output) {
     std::string err = prepare_directory();
     if (!err.empty()) {
@@ -77,6 +103,237 @@ RunResult Run<D>::execute(bool check_only) {
     }
   }
   return loop();
+}
+
+// ------------------------------------------------------------------ checkpoints
+// A checkpoint holds what the loop needs to go on bit for bit: every particle field of every set
+// in its current order, the ids, bodies and materials, each set's partition (the block order of
+// the scatter; it depends on the thread count, so a resume with other threads sorts again and is
+// then not bitwise), the simulation's counters, the loop's state (LoopState), the writer's frame
+// list and the state of the reference and the sources (Reference::save_state). The config echo,
+// the version and the commit must match the resumed run's.
+
+/// Why output.checkpoint cannot be used with this run ("" if it can).
+template <int D>
+std::string Run<D>::checkpoint_problem() const {
+  std::vector<double> state;
+  if (sim_->reference && !sim_->reference->save_state(state))
+    return "the reference '" + cfg_.params.section("verify").type() +
+           "' cannot be checkpointed yet (its state is not saved)";
+  for (size_t i = 0; i < sim_->sources.size(); ++i)
+    if (!sim_->sources[i]->save_state(state))
+      return "source " + std::to_string(i) + " cannot be checkpointed yet (its state is not saved)";
+  return "";
+}
+
+template <int D>
+void Run<D>::write_checkpoint() {
+  const Simulation<D>& sim = *sim_;
+  char name[64];
+  std::snprintf(name, sizeof name, "checkpoint_%08ld.h5", sim.step);
+  const fs::path file = dir_ / name;
+  CheckpointWriter w(file.string());
+  w.text("meta.format", "loam checkpoint 1");
+  w.text("meta.version", loam_version() + " " + git_commit());
+  w.text("meta.config", cfg_.params.to_json().dump());
+  for (const auto& [k, v] : {std::pair<const char*, double>{"sim.time", sim.time},
+                             {"sim.step", double(sim.step)},
+                             {"sim.dt", sim.dt},
+                             {"sim.max_speed", sim.max_speed},
+                             {"sim.created", double(sim.created)},
+                             {"sim.removed", double(sim.removed)},
+                             {"sim.mass_created", sim.mass_created},
+                             {"sim.mass_removed", sim.mass_removed},
+                             {"sim.initial_mass", sim.initial_mass},
+                             {"sim.next_id", double(sim_->next_particle_id())},
+                             {"run.frames", double(frames_)},
+                             {"run.next_frame_time", ls_.next_frame_time},
+                             {"run.dt_first", ls_.dt_first},
+                             {"run.dt_min", ls_.dt_min},
+                             {"run.dt_max", ls_.dt_max},
+                             {"run.frame_step", double(ls_.frame_step)},
+                             {"run.history_step", double(ls_.history_step)},
+                             {"run.e0.kinetic", ls_.e0.kinetic},
+                             {"run.e0.strain", ls_.e0.strain},
+                             {"run.e0.gravity", ls_.e0.gravity}})
+    w.scalar(k, v);
+  w.doubles("run.e0.momentum", ls_.e0.momentum);
+  for (size_t k = 0; k < sim.sets.size(); ++k) {
+    const ParticleSet<D>& set = sim.sets[k];
+    const Particles<D>& P = set.particles;
+    const std::string pre = "set." + std::to_string(k) + ".";
+    w.scalar(pre + "size", double(P.size()));
+    w.u32(pre + "id", P.id);
+    w.u16(pre + "material", P.material);
+    w.u16(pre + "body", P.body);
+    nlohmann::json fields = nlohmann::json::array();  // name, components (to re-request)
+    for (int f = 0; f < P.num_fields(); ++f)
+      if (P.has(f)) {
+        fields.push_back({P.info(f).name, P.info(f).components});
+        for (int c = 0; c < P.info(f).components; ++c)
+          w.doubles(pre + "field." + P.info(f).name + "." + std::to_string(c), P.col(f, c),
+                    P.size());
+      }
+    w.text(pre + "fields", fields.dump());
+    w.scalar(pre + "last_sort", double(set.last_sort));
+    w.scalar(pre + "resized", set.resized ? 1.0 : 0.0);
+    // The partition: threads, the material ranges, then per slab its rows and ranges.
+    std::vector<double> part{double(set.partition.threads),
+                             double(set.partition.material_ranges.size())};
+    for (const auto& r : set.partition.material_ranges)
+      part.insert(part.end(), {double(r.begin), double(r.end)});
+    part.push_back(double(set.partition.slabs.size()));
+    for (const auto& slab : set.partition.slabs) {
+      part.insert(part.end(),
+                  {double(slab.row_min), double(slab.row_max), double(slab.ranges.size())});
+      for (const auto& r : slab.ranges) part.insert(part.end(), {double(r.begin), double(r.end)});
+    }
+    w.doubles(pre + "partition", part);
+  }
+  w.text("run.writer", writer_->state());
+  std::vector<double> state;
+  if (sim.reference && sim.reference->save_state(state)) w.doubles("plugin.reference", state);
+  for (size_t i = 0; i < sim.sources.size(); ++i)
+    if (state.clear(), sim.sources[i]->save_state(state))
+      w.doubles("plugin.source." + std::to_string(i), state);
+  w.close();
+  checkpoints_.push_back(file);
+  while (int(checkpoints_.size()) > checkpoint_keep_) {
+    std::error_code ec;
+    fs::remove(checkpoints_.front(), ec);
+    checkpoints_.erase(checkpoints_.begin());
+  }
+}
+
+template <int D>
+void Run<D>::restore_checkpoint() {
+  Simulation<D>& sim = *sim_;
+  CheckpointReader r(resume_file_.string());
+  sim.time = r.scalar("sim.time");
+  sim.step = long(r.scalar("sim.step"));
+  sim.dt = r.scalar("sim.dt");
+  sim.max_speed = r.scalar("sim.max_speed");
+  sim.created = size_t(r.scalar("sim.created"));
+  sim.removed = size_t(r.scalar("sim.removed"));
+  sim.mass_created = r.scalar("sim.mass_created");
+  sim.mass_removed = r.scalar("sim.mass_removed");
+  sim.initial_mass = r.scalar("sim.initial_mass");
+  sim.next_particle_id() = uint32_t(r.scalar("sim.next_id"));
+  ls_.next_frame_time = r.scalar("run.next_frame_time");
+  ls_.dt_first = r.scalar("run.dt_first");
+  ls_.dt_min = r.scalar("run.dt_min");
+  ls_.dt_max = r.scalar("run.dt_max");
+  ls_.frame_step = long(r.scalar("run.frame_step"));
+  ls_.history_step = long(r.scalar("run.history_step"));
+  ls_.e0.kinetic = r.scalar("run.e0.kinetic");
+  ls_.e0.strain = r.scalar("run.e0.strain");
+  ls_.e0.gravity = r.scalar("run.e0.gravity");
+  ls_.e0.momentum = r.doubles("run.e0.momentum");
+  for (size_t k = 0; k < sim.sets.size(); ++k) {
+    ParticleSet<D>& set = sim.sets[k];
+    Particles<D>& P = set.particles;
+    const std::string pre = "set." + std::to_string(k) + ".";
+    // A field a plugin requested after the set-up (during a step) exists in the checkpoint but
+    // not yet here: request it with its stored size, then fill every field.
+    for (const auto& f : nlohmann::json::parse(r.text(pre + "fields"))) {
+      const std::string fname = f[0];
+      const int h = P.find(fname);
+      if (h < 0 || !P.has(h)) {
+        FieldInfo info;
+        info.name = fname;
+        info.components = f[1];
+        P.request(info);
+      }
+    }
+    P.resize(size_t(r.scalar(pre + "size")));
+    P.id = r.u32(pre + "id");
+    P.material = r.u16(pre + "material");
+    P.body = r.u16(pre + "body");
+    for (int f = 0; f < P.num_fields(); ++f)
+      if (P.has(f))
+        for (int c = 0; c < P.info(f).components; ++c) {
+          const auto v = r.doubles(pre + "field." + P.info(f).name + "." + std::to_string(c));
+          std::copy(v.begin(), v.end(), P.col(f, c));
+        }
+    set.last_sort = long(r.scalar(pre + "last_sort"));
+    set.resized = r.scalar(pre + "resized") != 0;
+    const auto part = r.doubles(pre + "partition");
+    if (int(part[0]) != sim.threads) {  // another thread count: its own block order
+      sim.sort(set);
+      continue;
+    }
+    size_t i = 1;
+    auto next = [&] { return size_t(part.at(i++)); };
+    set.partition.threads = int(part[0]);
+    set.partition.material_ranges.assign(next(), {});
+    for (auto& m : set.partition.material_ranges) m.begin = next(), m.end = next();
+    set.partition.slabs.assign(next(), {});
+    for (auto& slab : set.partition.slabs) {
+      slab.row_min = int(next());
+      slab.row_max = int(next());
+      slab.ranges.assign(next(), {});
+      for (auto& range : slab.ranges) range.begin = next(), range.end = next();
+    }
+  }
+  if (sim.reference) sim.reference->restore_state(r.doubles("plugin.reference"));
+  for (size_t i = 0; i < sim.sources.size(); ++i)
+    sim.sources[i]->restore_state(r.doubles("plugin.source." + std::to_string(i)));
+  // The checkpoints of the run so far, and none from beyond this one (that future is redone).
+  for (const auto& e : fs::directory_iterator(dir_)) {
+    const std::string n = e.path().filename().string();
+    if (n.rfind("checkpoint_", 0) != 0 || e.path().extension() != ".h5") continue;
+    if (std::stol(n.substr(11)) > sim.step) {
+      std::error_code ec;
+      fs::remove(e.path(), ec);
+    } else {
+      checkpoints_.push_back(e.path());
+    }
+  }
+  std::sort(checkpoints_.begin(), checkpoints_.end());
+}
+
+/// --resume DIR (its newest readable checkpoint) or --resume FILE: sets dir_ and
+/// resume_file_, and checks that the checkpoint is this run's (config, version, commit).
+template <int D>
+std::string Run<D>::find_resume_checkpoint() {
+  const fs::path given(opt_.resume);
+  std::vector<fs::path> candidates;
+  if (fs::is_directory(given)) {
+    dir_ = given;
+    for (const auto& e : fs::directory_iterator(given)) {
+      const std::string n = e.path().filename().string();
+      if (n.rfind("checkpoint_", 0) == 0 && e.path().extension() == ".h5")
+        candidates.push_back(e.path());
+    }
+    std::sort(candidates.rbegin(), candidates.rend());  // newest first
+    if (candidates.empty()) return "no checkpoint_*.h5 in " + given.string();
+  } else if (fs::exists(given)) {
+    dir_ = given.parent_path().empty() ? fs::path(".") : given.parent_path();
+    candidates.push_back(given);
+  } else {
+    return "--resume " + given.string() + ": no such directory or checkpoint file";
+  }
+  std::string why;
+  for (const auto& c : candidates) {
+    try {
+      CheckpointReader r(c.string());
+      if (r.text("meta.format") != "loam checkpoint 1") {
+        why = c.string() + " is not a loam checkpoint";
+        continue;
+      }
+      if (r.text("meta.version") != loam_version() + " " + git_commit())
+        return "checkpoint " + c.string() + " was written by loam " + r.text("meta.version") +
+               ", this is " + loam_version() + " " + git_commit() + ": resume with that binary";
+      if (r.text("meta.config") != cfg_.params.to_json().dump())
+        return "checkpoint " + c.string() + " belongs to another configuration (its config " +
+               "echo differs from this run's after overrides): resume with the same file and --set";
+      resume_file_ = c;
+      return "";
+    } catch (const std::exception& e) {
+      why = e.what();  // an unreadable (e.g. cut) checkpoint: try the one before
+    }
+  }
+  return "no valid checkpoint to resume from: " + why;
 }
 
 template <int D>
@@ -126,7 +383,8 @@ RunResult Run<D>::loop() {
   double every_time = out.has("every_time") ? out.real("every_time") : 0;
   if (!every_steps && every_time <= 0) every_time = sim.end_time / 20;
   const long history_every = long(out.integer("history_every"));
-  double next_frame_time = every_time;
+  const bool resuming = !resume_file_.empty();
+  if (!resuming) ls_.next_frame_time = every_time;
   const bool files = opt_.write_output;
   // A file that cannot be written (WriteError, a failed rename) stops the run with exit 4.
   std::string write_error;
@@ -140,45 +398,54 @@ RunResult Run<D>::loop() {
       write_error = "cannot write " + e.path1().string() + ": " + e.code().message();
     }
   };
+  if (resuming) {
+    restore_checkpoint();
+  } else {
+    ls_.e0 = sim.energies();
+  }
   if (files)
     guarded([&] {
-      open_outputs();
-      write_frame("");
-      write_history();
-      sample_probes(true);
+      open_outputs(resuming ? sim.step : -1);
+      if (resuming) {
+        CheckpointReader ck(resume_file_.string());
+        writer_->restore_state(ck.text("run.writer"));
+        frames_ = long(ck.scalar("run.frames"));
+      } else {
+        write_frame("");
+        write_history();
+        sample_probes(true);
+      }
     });
-  Energies e0 = sim.energies();
-  double dt_min = 1e300, dt_max = 0;
+  auto last_checkpoint = Clock::now();
   std::string failure;
   auto t0 = Clock::now(), last_report = t0;
   long steps_at_report = 0;
   const double t_end = sim.end_time;
   const double min_dt_ratio = cfg_.params.section("time").real("min_dt_ratio");
-  double dt_first = 0;
   int interrupted = 0;                           // the signal that stopped the run (InterruptGuard)
-  long frame_step = 0, history_step = 0;         // the steps of the last frame and history row
-  if (sim.keep_last_good) sim.save_last_good();  // t = 0: it passed the set-up checks
+  if (sim.keep_last_good) sim.save_last_good();  // t = 0 (or the checkpoint) passed the checks
   while (write_error.empty() && sim.time < t_end * (1 - 1e-12) &&
          (opt_.max_steps < 0 || sim.step < opt_.max_steps)) {
     double dt = sim.stable_dt();
-    if (dt_first == 0) dt_first = dt;
-    if (dt < min_dt_ratio * dt_first) {
+    if (ls_.dt_first == 0) ls_.dt_first = dt;
+    if (dt < min_dt_ratio * ls_.dt_first) {
       failure = "the stable time step collapsed to " + format_number(dt) + " s, below " +
                 "time.min_dt_ratio = " + format_number(min_dt_ratio) + " of the first step's " +
-                format_number(dt_first) + " s (largest particle speed " +
+                format_number(ls_.dt_first) + " s (largest particle speed " +
                 format_number(sim.max_speed) +
                 " m/s): a wave or particle speed exploded; remedies: scheme.update: musl, a "
                 "smaller time.cfl, a smooth shape function (gimp, bspline2, cpdi)";
       break;
     }
     if (sim.time + dt > t_end) dt = t_end - sim.time;
-    dt_min = std::min(dt_min, dt);
-    dt_max = std::max(dt_max, dt);
+    ls_.dt_min = std::min(ls_.dt_min, dt);
+    ls_.dt_max = std::max(ls_.dt_max, dt);
     // Whether the step ends at a frame or the end (the particles are then always checked).
     const long next_step = sim.step + 1;
     const double next_time = sim.time + dt;
-    const bool frame_due = files && ((every_steps && next_step % every_steps == 0) ||
-                                     (every_time > 0 && next_time >= next_frame_time * (1 - 1e-9)));
+    const bool frame_due =
+        files && ((every_steps && next_step % every_steps == 0) ||
+                  (every_time > 0 && next_time >= ls_.next_frame_time * (1 - 1e-9)));
     const bool last = next_time >= t_end * (1 - 1e-12) || next_step == opt_.max_steps;
     if (!sim.advance(dt, frame_due || last)) {
       failure = sim.failure;
@@ -187,7 +454,7 @@ RunResult Run<D>::loop() {
     if (sim.step >= sim.max_steps && sim.time < t_end * (1 - 1e-12)) {
       failure = "time.max_steps = " + std::to_string(sim.max_steps) +
                 " reached before t = " + format_number(t_end) + " s; the time step fell to " +
-                format_number(dt) + " s (it was " + format_number(dt_max) + " s at most)";
+                format_number(dt) + " s (it was " + format_number(ls_.dt_max) + " s at most)";
       break;
     }
     if (sim.reference) sim.reference->sample(sim);
@@ -196,14 +463,22 @@ RunResult Run<D>::loop() {
         sample_probes(last);
         if (frame_due || last) {
           write_frame("");
-          frame_step = sim.step;
-          while (every_time > 0 && next_frame_time <= sim.time * (1 + 1e-9))
-            next_frame_time += every_time;
+          ls_.frame_step = sim.step;
+          while (every_time > 0 && ls_.next_frame_time <= sim.time * (1 + 1e-9))
+            ls_.next_frame_time += every_time;
         }
         if ((history_every > 0 && sim.step % history_every == 0) ||
             (history_every == 0 && (frame_due || last))) {
           write_history();
-          history_step = sim.step;
+          ls_.history_step = sim.step;
+        }
+        const bool due = (checkpoint_every_ > 0 && sim.step % checkpoint_every_ == 0) ||
+                         (checkpoint_wall_ > 0 &&
+                          std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >=
+                              checkpoint_wall_);
+        if (due && !last) {
+          write_checkpoint();
+          last_checkpoint = Clock::now();
         }
       });
     if (!write_error.empty()) break;
@@ -223,9 +498,10 @@ RunResult Run<D>::loop() {
   }
   if (interrupted && files)  // the state after the last complete step, as a regular frame
     guarded([&] {
-      if (frame_step != sim.step) write_frame("");
+      if (ls_.frame_step != sim.step) write_frame("");
       sample_probes(true);
-      if (history_step != sim.step) write_history();
+      if (ls_.history_step != sim.step) write_history();
+      if (checkpoint_every_ > 0 || checkpoint_wall_ > 0) write_checkpoint();
     });
   double wall = std::chrono::duration<double>(Clock::now() - t0).count();
   res.summary = base_summary();
@@ -237,8 +513,8 @@ RunResult Run<D>::loop() {
   res.summary["threads"] = sim.threads;
   res.summary["particle_steps_per_second"] =
       wall > 0 ? double(sim.num_particles()) * double(sim.step) / wall : 0.0;
-  res.summary["dt_min"] = dt_min < 1e300 ? dt_min : 0.0;
-  res.summary["dt_max"] = dt_max;
+  res.summary["dt_min"] = ls_.dt_min < 1e300 ? ls_.dt_min : 0.0;
+  res.summary["dt_max"] = ls_.dt_max;
   res.summary["frames"] = frames_;
   if (sim.profiling) res.summary["profile_seconds"] = sim.profile;
   Energies e1 = sim.energies();
@@ -259,7 +535,7 @@ RunResult Run<D>::loop() {
       {"created", sim.mass_created},
       {"removed", sim.mass_removed},
       {"balance", mass_now + sim.mass_removed - sim.mass_created - sim.initial_mass}};
-  res.summary["energy_initial"] = energy_json(e0);
+  res.summary["energy_initial"] = energy_json(ls_.e0);
   res.summary["energy_final"] = energy_json(e1);
   res.summary["verify"] = nlohmann::json::object();  // always there: empty without a reference
   if (sim.reference) {
@@ -279,7 +555,7 @@ RunResult Run<D>::loop() {
       // already), then the state at detection as 'failed'.
       const auto& good = sim.last_good;
       if (good.step >= 0) {
-        if (good.step != frame_step) {
+        if (good.step != ls_.frame_step) {
           sim.swap_last_good();
           guarded([&] { write_frame(""); });
           sim.swap_last_good();

@@ -18,6 +18,9 @@ struct RunOptions {
   bool write_output = true;  // false: no directory, no files (benchmarks)
   long max_steps = -1;       // stop after this many steps (benchmarks)
   bool profile = false;      // time each phase of the step (summary: profile_seconds)
+  /// Continue the run whose output directory (its newest checkpoint) or checkpoint file this
+  /// names; the output goes on in that directory.
+  std::string resume;
 };
 
 struct RunResult {

@@ -221,6 +221,8 @@ class Simulation {
   /// body's spacing and density, then the shape function's, the scheme's and the material's
   /// initialisation); counted in mass_created. The set is re-sorted before the next scatter.
   void add_particles(int body, const std::vector<Vec>& x, const Vec& v);
+  /// The id the next created particle gets (checkpoints keep it).
+  uint32_t& next_particle_id() { return next_id_; }
   /// Particle counts and masses that sources and sinks moved across the run's boundary: the mass
   /// balance mass now + mass_removed - mass_created - initial_mass is round-off (the `mass`
   /// field: the whole mass in one-phase schemes, the solid mass in two-phase ones).

@@ -22,6 +22,11 @@ class Source {
   virtual void apply(Simulation<D>&, double t) = 0;
   /// The box where it creates particles (for the check that no sink removes them there).
   virtual void region(std::array<double, D>& lower, std::array<double, D>& upper) const = 0;
+  /// Checkpoints (output.checkpoint): the plugin's accumulated state as doubles, restored
+  /// bit for bit on --resume. false: it has none implemented yet, and a checkpointed run with
+  /// it is refused (a silently lost state would break the resumed run's results).
+  virtual bool save_state(std::vector<double>&) const { return false; }
+  virtual void restore_state(const std::vector<double>&) {}
 };
 
 }  // namespace loam

@@ -35,6 +35,10 @@ class Writer {
   /// Write one frame; `label` is "" for a regular frame or e.g. "failed" for the last state.
   virtual void write(Simulation<D>&, const std::string& label) = 0;
   virtual void close() {}
+  /// Checkpoints: the frames written so far (a writer keeping an index needs them to go on
+  /// after --resume), as text; restored after open().
+  virtual std::string state() const { return ""; }
+  virtual void restore_state(const std::string&) {}
 };
 
 }  // namespace loam

@@ -126,6 +126,17 @@ class Terzaghi : public Reference<D> {
     return m;
   }
 
+  bool save_state(std::vector<double>& s) const override {
+    s = max_err_;  // the geometry (H0, span0, offsets) is the set-up's, recomputed on resume
+    s.insert(s.end(), u_err_.begin(), u_err_.end());
+    return true;
+  }
+  void restore_state(const std::vector<double>& s) override {
+    const size_t n = max_err_.size();
+    max_err_.assign(s.begin(), s.begin() + long(n));
+    u_err_.assign(s.begin() + long(n), s.begin() + long(2 * n));
+  }
+
  private:
   std::pair<double, double> span(const Simulation<D>& sim) const {
     const auto& P = sim.particles_of_body(body_);

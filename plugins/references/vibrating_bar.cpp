@@ -99,6 +99,17 @@ class VibratingBar : public Reference<D> {
     return m;
   }
 
+  bool save_state(std::vector<double>& s) const override {
+    s = {last_v_, last_t_, max_u_, drift_, field_error_};
+    s.insert(s.end(), crossings_.begin(), crossings_.end());
+    return true;
+  }
+  void restore_state(const std::vector<double>& s) override {
+    last_v_ = s.at(0), last_t_ = s.at(1), max_u_ = s.at(2), drift_ = s.at(3);
+    field_error_ = s.at(4);
+    crossings_.assign(s.begin() + 5, s.end());
+  }
+
  private:
   double energy(Simulation<D>& sim) {
     Energies e = sim.energies();

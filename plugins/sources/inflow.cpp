@@ -88,6 +88,13 @@ class Inflow : public Source<D> {
   }
 
   void region(Vec& lower, Vec& upper) const override { lower = lo_, upper = hi_; }
+  bool save_state(std::vector<double>& s) const override {
+    s = {filled_ ? 1.0 : 0.0, newest_time_, newest_offset_};
+    return true;
+  }
+  void restore_state(const std::vector<double>& s) override {
+    filled_ = s.at(0) != 0, newest_time_ = s.at(1), newest_offset_ = s.at(2);
+  }
 
   void apply(Simulation<D>& sim, double t) override {
     if (body_ < 0 || t < start_ * (1 - 1e-12) || t >= end_) return;

@@ -100,6 +100,7 @@ class Reservoir : public Source<D> {
   }
 
   void region(Vec& lower, Vec& upper) const override { lower = lo_, upper = hi_; }
+  bool save_state(std::vector<double>&) const override { return true; }  // none: the level is t's
 
   void apply(Simulation<D>& sim, double) override {
     if (body_ < 0 || layer_.empty()) return;

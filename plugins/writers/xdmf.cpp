@@ -5,6 +5,8 @@
 // Every file is written under a temporary name and renamed when complete.
 #include <hdf5.h>
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -30,6 +32,44 @@ class Xdmf : public Writer<D> {
     dir_ = dir;
     fields_ = fields;
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // failures are reported as WriteError
+  }
+
+  /// The frame list of every set (checkpoints: the index goes on after --resume).
+  std::string state() const override {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& set : frames_) {
+      nlohmann::json js = nlohmann::json::array();
+      for (const auto& f : set) {
+        auto attrs = [](const std::vector<Attribute>& as) {
+          nlohmann::json a = nlohmann::json::array();
+          for (const auto& x : as) a.push_back({x.name, x.width, x.number_type});
+          return a;
+        };
+        js.push_back({{"file", f.file},
+                      {"time", f.time},
+                      {"step", f.step},
+                      {"n", f.n},
+                      {"attributes", attrs(f.attributes)},
+                      {"grid_nodes", f.grid_nodes},
+                      {"grid_attributes", attrs(f.grid_attributes)}});
+      }
+      j.push_back(js);
+    }
+    return j.dump();
+  }
+  void restore_state(const std::string& text) override {
+    const auto j = nlohmann::json::parse(text);
+    frames_.assign(j.size(), {});
+    for (size_t s = 0; s < j.size(); ++s)
+      for (const auto& f : j[s]) {
+        auto attrs = [](const nlohmann::json& a) {
+          std::vector<Attribute> as;
+          for (const auto& x : a) as.push_back({x[0], x[1], x[2]});
+          return as;
+        };
+        frames_[s].push_back(Frame{f["file"], f["time"], f["step"], f["n"], attrs(f["attributes"]),
+                                   f["grid_nodes"], attrs(f["grid_attributes"])});
+      }
   }
 
   void write(Simulation<D>& sim, const std::string& label) override {
