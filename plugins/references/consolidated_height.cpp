@@ -61,6 +61,9 @@ class ConsolidatedHeight : public Reference<D> {
     return m;
   }
 
+  /// Checkpoints: nothing accumulates; everything is the set-up's or the final state's.
+  bool save_state(std::vector<double>&) const override { return true; }
+
  private:
   /// J = h / H0 of the drained column.
   double stretch() const {

@@ -81,6 +81,9 @@ class ElasticColumn : public Reference<D> {
     return m;
   }
 
+  /// Checkpoints: nothing accumulates; everything is the set-up's or the final state's.
+  bool save_state(std::vector<double>&) const override { return true; }
+
  private:
   Params params_;
   int body_ = 0, z0_ = -1;

@@ -88,6 +88,19 @@ class ScourDepth : public Reference<D> {
     return {{"time", time_}, {"scour_depth", depth_}};
   }
 
+  bool save_state(std::vector<double>& s) const override {
+    s = {next_};
+    s.insert(s.end(), time_.begin(), time_.end());
+    s.insert(s.end(), depth_.begin(), depth_.end());
+    return true;
+  }
+  void restore_state(const std::vector<double>& s) override {
+    next_ = s.at(0);
+    const long n = long(s.size() - 1) / 2;
+    time_.assign(s.begin() + 1, s.begin() + 1 + n);
+    depth_.assign(s.begin() + 1 + n, s.end());
+  }
+
  private:
   /// The highest grain of the bed in contact within the strip (-inf if none).
   double strip_top(const Simulation<D>& sim) const {

@@ -72,6 +72,9 @@ class Settlement : public Reference<D> {
     return m;
   }
 
+  /// Checkpoints: nothing accumulates; everything is the set-up's or the final state's.
+  bool save_state(std::vector<double>&) const override { return true; }
+
  private:
   Params params_;
   Column<D> col_;

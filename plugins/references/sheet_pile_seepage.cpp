@@ -228,6 +228,22 @@ class SheetPileSeepage : public Reference<D> {
             {"heave", heave_}};
   }
 
+  bool save_state(std::vector<double>& s) const override {
+    s = {next_, critical_, double(time_.size())};
+    for (const auto* v : {&time_, &head_, &up_, &down_, &exit_, &harr_, &fluidised_, &heave_})
+      s.insert(s.end(), v->begin(), v->end());
+    return true;
+  }
+  void restore_state(const std::vector<double>& s) override {
+    next_ = s.at(0), critical_ = s.at(1);
+    const long n = long(s.at(2));
+    long k = 3;
+    for (auto* v : {&time_, &head_, &up_, &down_, &exit_, &harr_, &fluidised_, &heave_}) {
+      v->assign(s.begin() + k, s.begin() + k + n);
+      k += n;
+    }
+  }
+
  private:
   /// Terzaghi's prism: the mean of Harr's excess head fraction on its base (depth d, from the
   /// pile to d/2 downstream), by Simpson's rule on 200 intervals.
