@@ -131,7 +131,6 @@ class Particles {
     n_ = kept;
   }
 
-  /// Reorder every column so that new[i] = old[order[i]] (after sorting by cell).
   /// Copy every field into `dst` (the last-good snapshot): the columns in parallel once dst has
   /// this layout (after the first copy), a plain copy otherwise.
   void copy_to(Particles& dst, int threads) const {
@@ -158,6 +157,7 @@ class Particles {
     for (size_t f = 0; f < fields_.size(); ++f) dst.fields_[f].info = fields_[f].info;
   }
 
+  /// Reorder every column so that new[i] = old[order[i]] (after sorting by cell).
   void permute(const std::vector<uint32_t>& order, int threads = 1) {
     // Columns are independent: permute them in parallel, one scratch column per thread.
     std::vector<std::vector<double>*> columns;

@@ -1,18 +1,30 @@
 #pragma once
+// Reference (analytic solution) plugin interface, selected by `verify:`. It samples the run as it
+// goes and returns named error metrics, written to summary.json.
+#include <cmath>
 #include <map>
 #include <string>
 #include <utility>
 #include <vector>
-// Reference (analytic solution) plugin interface, selected by `verify:`. It samples the run as it
-// goes and returns named error metrics, written to summary.json.
-#include <map>
-#include <string>
 
 namespace loam {
 
 template <int D>
 class Simulation;
 class Diagnostics;
+
+/// When a reference that records a time series samples: at the first step, then each time the
+/// run passes a multiple of `every` seconds; restart() makes the next call due (the end of the
+/// run is always sampled). `next` is its whole state (a reference checkpoints it).
+struct SampleClock {
+  double every = 0, next = 0;
+  bool due(double t) {
+    if (t < next * (1 - 1e-12) - 1e-15) return false;
+    next = (std::floor(t / every + 1e-9) + 1) * every;
+    return true;
+  }
+  void restart() { next = 0; }
+};
 
 template <int D>
 class Reference {

@@ -112,6 +112,7 @@ class Run {
   int checkpoint_keep_ = 2;
   std::vector<fs::path> checkpoints_;  // oldest first
   fs::path resume_file_;               // --resume: the checkpoint to continue from
+  std::string resume_writer_state_;    // its writer state, restored once the writer is open
   std::string checkpoint_problem() const;
   void write_checkpoint();
   void restore_checkpoint();

@@ -253,22 +253,7 @@ void Run<D>::write_history() {
 
 template <int D>
 void Run<D>::write_summary(const nlohmann::json& summary) {
-  const fs::path file = dir_ / "summary.json", tmp = dir_ / "summary.json.tmp";
-  errno = 0;
-  bool written;
-  {
-    std::ofstream js(tmp);
-    js << summary.dump(2) << "\n";
-    js.flush();
-    written = bool(js);
-  }
-  if (!written) {
-    const std::string reason = WriteError::os_reason();
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw WriteError(file.string(), reason);
-  }
-  fs::rename(tmp, file);
+  write_file_atomically((dir_ / "summary.json").string(), summary.dump(2) + "\n");
 }
 
 template <int D>

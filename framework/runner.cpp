@@ -6,10 +6,12 @@
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "checkpoint.hpp"
 #include "interrupt.hpp"
@@ -22,13 +24,29 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// A reference's time series as CSV (a column per series, full precision), written under a
-/// temporary name and renamed, like summary.json.
+/// The checkpoint_<step>.h5 files of an output directory, oldest first (the zero-padded step
+/// sorts by name).
+std::vector<std::filesystem::path> checkpoint_files(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string n = e.path().filename().string();
+    if (n.rfind("checkpoint_", 0) == 0 && e.path().extension() == ".h5") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+/// The step in a checkpoint's name.
+long checkpoint_step(const std::filesystem::path& file) {
+  return std::stol(file.filename().string().substr(11));
+}
+
+/// A reference's time series as CSV (a column per series, full precision), written whole or not
+/// at all, like summary.json.
 void write_series_csv(const std::filesystem::path& file,
                       const std::vector<std::pair<std::string, std::vector<double>>>& series) {
-  const auto tmp = std::filesystem::path(file.string() + ".tmp");
+  std::ostringstream out;
   {
-    std::ofstream out(tmp);
     size_t rows = 0;
     for (size_t c = 0; c < series.size(); ++c) {
       out << (c ? "," : "") << series[c].first;
@@ -45,7 +63,7 @@ void write_series_csv(const std::filesystem::path& file,
       out << "\n";
     }
   }
-  std::filesystem::rename(tmp, file);
+  write_file_atomically(file.string(), out.str());
 }
 
 }  // namespace
@@ -278,18 +296,18 @@ void Run<D>::restore_checkpoint() {
   if (sim.reference) sim.reference->restore_state(r.doubles("plugin.reference"));
   for (size_t i = 0; i < sim.sources.size(); ++i)
     sim.sources[i]->restore_state(r.doubles("plugin.source." + std::to_string(i)));
+  // The writer's frame list comes back once the writer is open (loop()).
+  resume_writer_state_ = r.text("run.writer");
+  frames_ = long(r.scalar("run.frames"));
   // The checkpoints of the run so far, and none from beyond this one (that future is redone).
-  for (const auto& e : fs::directory_iterator(dir_)) {
-    const std::string n = e.path().filename().string();
-    if (n.rfind("checkpoint_", 0) != 0 || e.path().extension() != ".h5") continue;
-    if (std::stol(n.substr(11)) > sim.step) {
+  for (const auto& file : checkpoint_files(dir_)) {
+    if (checkpoint_step(file) > sim.step) {
       std::error_code ec;
-      fs::remove(e.path(), ec);
+      fs::remove(file, ec);
     } else {
-      checkpoints_.push_back(e.path());
+      checkpoints_.push_back(file);
     }
   }
-  std::sort(checkpoints_.begin(), checkpoints_.end());
 }
 
 /// --resume DIR (its newest readable checkpoint) or --resume FILE: sets dir_ and
@@ -300,12 +318,8 @@ std::string Run<D>::find_resume_checkpoint() {
   std::vector<fs::path> candidates;
   if (fs::is_directory(given)) {
     dir_ = given;
-    for (const auto& e : fs::directory_iterator(given)) {
-      const std::string n = e.path().filename().string();
-      if (n.rfind("checkpoint_", 0) == 0 && e.path().extension() == ".h5")
-        candidates.push_back(e.path());
-    }
-    std::sort(candidates.rbegin(), candidates.rend());  // newest first
+    candidates = checkpoint_files(given);
+    std::reverse(candidates.begin(), candidates.end());  // newest first
     if (candidates.empty()) return "no checkpoint_*.h5 in " + given.string();
   } else if (fs::exists(given)) {
     dir_ = given.parent_path().empty() ? fs::path(".") : given.parent_path();
@@ -407,9 +421,7 @@ RunResult Run<D>::loop() {
     guarded([&] {
       open_outputs(resuming ? sim.step : -1);
       if (resuming) {
-        CheckpointReader ck(resume_file_.string());
-        writer_->restore_state(ck.text("run.writer"));
-        frames_ = long(ck.scalar("run.frames"));
+        writer_->restore_state(resume_writer_state_);
       } else {
         write_frame("");
         write_history();
@@ -545,7 +557,7 @@ RunResult Run<D>::loop() {
     const auto series = sim.reference->series();
     for (const auto& [name, values] : series) v["series"][name] = values;
     res.summary["verify"] = v;
-    if (files && !series.empty()) write_series_csv(dir_ / "verify.csv", series);
+    if (files && !series.empty()) guarded([&] { write_series_csv(dir_ / "verify.csv", series); });
   }
   if (!failure.empty()) {
     res.exit_code = 3;

@@ -21,6 +21,10 @@ struct WriteError : std::runtime_error {
   }
 };
 
+/// Write `text` to `file` whole or not at all: into file.tmp, flushed and checked, then renamed
+/// (summary.json, verify.csv, the XDMF index). A failure removes the .tmp and throws WriteError.
+void write_file_atomically(const std::string& file, const std::string& text);
+
 template <int D>
 class Simulation;
 

@@ -45,7 +45,7 @@ class ScourDepth : public Reference<D> {
       : params_(p),
         axis_(p.vec("axis")),
         half_width_(p.real("half_width")),
-        every_(p.real("every")) {}
+        clock_{p.real("every")} {}
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     if (int(axis_.size()) != D - 1) {
@@ -64,8 +64,7 @@ class ScourDepth : public Reference<D> {
   }
 
   void sample(Simulation<D>& sim) override {
-    if (sim.time < next_ * (1 - 1e-12) - 1e-15) return;
-    next_ = (std::floor(sim.time / every_ + 1e-9) + 1) * every_;
+    if (!clock_.due(sim.time)) return;
     const double top = strip_top(sim);
     time_.push_back(sim.time);
     depth_.push_back(std::isfinite(top) ? bed_ - top : std::nan(""));
@@ -73,7 +72,7 @@ class ScourDepth : public Reference<D> {
 
   std::map<std::string, double> metrics(Simulation<D>& sim) override {
     if (time_.empty() || time_.back() < sim.time) {
-      next_ = 0;  // the end of the run is always sampled
+      clock_.restart();  // the end of the run is always sampled
       sample(sim);
     }
     double worst = -std::numeric_limits<double>::infinity();
@@ -89,13 +88,13 @@ class ScourDepth : public Reference<D> {
   }
 
   bool save_state(std::vector<double>& s) const override {
-    s = {next_};
+    s = {clock_.next};
     s.insert(s.end(), time_.begin(), time_.end());
     s.insert(s.end(), depth_.begin(), depth_.end());
     return true;
   }
   void restore_state(const std::vector<double>& s) override {
-    next_ = s.at(0);
+    clock_.next = s.at(0);
     const long n = long(s.size() - 1) / 2;
     time_.assign(s.begin() + 1, s.begin() + 1 + n);
     depth_.assign(s.begin() + 1 + n, s.end());
@@ -118,7 +117,8 @@ class ScourDepth : public Reference<D> {
 
   Params params_;
   std::vector<double> axis_;
-  double half_width_, every_, bed_ = 0, next_ = 0;
+  double half_width_, bed_ = 0;
+  SampleClock clock_;
   int body_ = -1, contact_ = -1;
   std::vector<double> time_, depth_;
 };

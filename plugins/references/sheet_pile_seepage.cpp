@@ -68,7 +68,7 @@ class SheetPileSeepage : public Reference<D> {
     return s;
   }
   explicit SheetPileSeepage(const Params& p)
-      : params_(p), x_pile_(p.real("pile")), d_(p.real("depth")), every_(p.real("every")) {}
+      : params_(p), x_pile_(p.real("pile")), d_(p.real("depth")), clock_{p.real("every")} {}
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     if (D < 2) {
@@ -131,8 +131,7 @@ class SheetPileSeepage : public Reference<D> {
   }
 
   void sample(Simulation<D>& sim) override {
-    if (sim.time < next_ * (1 - 1e-12) - 1e-15) return;
-    next_ = (std::floor(sim.time / every_ + 1e-9) + 1) * every_;
+    if (!clock_.due(sim.time)) return;
     const Particles<D>& P = sim.sets[size_t(set_)].particles;
     const double* y = P.col(P.position, D - 1);
     const double* x = P.col(P.position, 0);
@@ -195,7 +194,7 @@ class SheetPileSeepage : public Reference<D> {
 
   std::map<std::string, double> metrics(Simulation<D>& sim) override {
     if (time_.empty() || time_.back() < sim.time) {
-      next_ = 0;  // the end of the run is always sampled
+      clock_.restart();  // the end of the run is always sampled
       sample(sim);
     }
     const double harr = M_PI * d_ * i_c_;
@@ -229,13 +228,13 @@ class SheetPileSeepage : public Reference<D> {
   }
 
   bool save_state(std::vector<double>& s) const override {
-    s = {next_, critical_, double(time_.size())};
+    s = {clock_.next, critical_, double(time_.size())};
     for (const auto* v : {&time_, &head_, &up_, &down_, &exit_, &harr_, &fluidised_, &heave_})
       s.insert(s.end(), v->begin(), v->end());
     return true;
   }
   void restore_state(const std::vector<double>& s) override {
-    next_ = s.at(0), critical_ = s.at(1);
+    clock_.next = s.at(0), critical_ = s.at(1);
     const long n = long(s.at(2));
     long k = 3;
     for (auto* v : {&time_, &head_, &up_, &down_, &exit_, &harr_, &fluidised_, &heave_}) {
@@ -269,8 +268,10 @@ class SheetPileSeepage : public Reference<D> {
   }
 
   Params params_;
-  double x_pile_, d_, every_, surface_ = 0, gamma_w_ = 0, i_c_ = 0;
-  double width_ = 0, depth_ = 0, band_ = 0, heave_base_ = 0, next_ = 0;
+  double x_pile_, d_;
+  SampleClock clock_;
+  double surface_ = 0, gamma_w_ = 0, i_c_ = 0;
+  double width_ = 0, depth_ = 0, band_ = 0, heave_base_ = 0;
   double critical_ = std::nan("");
   int body_ = -1, set_ = -1, pressure_ = -1, contact_ = -1;
   std::vector<double> time_, head_, up_, down_, exit_, harr_, fluidised_, heave_;

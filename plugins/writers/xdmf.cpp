@@ -227,24 +227,7 @@ class Xdmf : public Writer<D> {
       x << "    </Grid>\n";
     }
     x << "  </Domain>\n</Xdmf>\n";
-    std::filesystem::path file = std::filesystem::path(dir_) / (set + ".xdmf");
-    std::filesystem::path tmp = file;
-    tmp += ".tmp";
-    errno = 0;
-    bool written;
-    {
-      std::ofstream o(tmp);
-      o << x.str();
-      o.flush();
-      written = bool(o);
-    }
-    if (!written) {
-      const std::string reason = WriteError::os_reason();
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw WriteError(file.string(), reason);
-    }
-    std::filesystem::rename(tmp, file);
+    write_file_atomically((std::filesystem::path(dir_) / (set + ".xdmf")).string(), x.str());
   }
 };
 
