@@ -97,6 +97,28 @@ inline CliResult run_yaml(const std::filesystem::path& dir, const std::string& y
                   (dir / "out").string() + " " + args);
 }
 
+/// Run a bash script through a real shell (for what a function call cannot show: signals to a
+/// running process, ulimit) and return the exit code of its last command, `$?`, which it
+/// writes to a file (std::system reports the shell's own status). No single quote in it.
+inline int run_bash(const std::string& script) {
+  static int count = 0;
+  const auto rc = std::filesystem::temp_directory_path() /
+                  ("loam_test_rc_" + std::to_string(getpid()) + "_" + std::to_string(count++));
+  const std::string cmd = "bash -c '" + script + "; echo $? > " + rc.string() + "'";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  int code = -1;
+  std::ifstream(rc) >> code;
+  std::filesystem::remove(rc);
+  return code;
+}
+
+/// Whether a directory holds a file with the .tmp extension (an output not completed).
+inline bool has_tmp_files(const std::filesystem::path& dir) {
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".tmp") return true;
+  return false;
+}
+
 /// The whole text of a file.
 inline std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p);

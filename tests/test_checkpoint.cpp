@@ -118,14 +118,9 @@ TEST_CASE("an interrupted run resumes to the uninterrupted run's final state",
       " --quiet --threads 1 --set time.end=5000 --set output.every_time=500 "
       "--set \"output.checkpoint={every_steps: 20000}\"";
   REQUIRE(loam_test::run_loam("run " + cfg + " --out " + a.path.string() + args).exit_code == 0);
-  const fs::path rc = b.path.string() + ".rc";
-  const std::string cmd = "bash -c '" + std::string(LOAM_EXE) + " run " + cfg + " --out " +
-                          b.path.string() + args + " & pid=$!; sleep 1; kill -INT $pid; wait " +
-                          "$pid; echo $? > " + rc.string() + "'";
-  REQUIRE(std::system(cmd.c_str()) == 0);
-  int code = -1;
-  std::ifstream(rc) >> code;
-  fs::remove(rc);
+  const int code =
+      loam_test::run_bash(std::string(LOAM_EXE) + " run " + cfg + " --out " + b.path.string() +
+                          args + " & pid=$!; sleep 1; kill -INT $pid; wait $pid");
   auto interrupted = nlohmann::json::parse(loam_test::slurp(b.path / "summary.json"));
   std::printf("interrupted at step %ld (exit %d); resuming\n", interrupted["steps"].get<long>(),
               code);

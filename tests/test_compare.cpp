@@ -105,15 +105,10 @@ TEST_CASE("loam compare stops cleanly on SIGINT and the same command resumes the
                        << "set: [time.end=3000, output.every_time=1000]\n"
                        << "axes:\n  scheme.flip: [1.0, 0.99]\nthreads: 1\n";
   const auto out = dir.path / "out";
-  const auto rc = dir.path / "rc";
-  const std::string cmd = "bash -c 'set -m; " + std::string(LOAM_EXE) + " compare " +
-                          sweep.string() + " --out " + out.string() +
-                          " >/dev/null 2>&1 & pid=$!; sleep 1; kill -INT -$pid; wait $pid; "
-                          "echo $? > " +
-                          rc.string() + "'";
-  REQUIRE(std::system(cmd.c_str()) == 0);
-  int code = -1;
-  std::ifstream(rc) >> code;
+  const int code = loam_test::run_bash("set -m; " + std::string(LOAM_EXE) + " compare " +
+                                       sweep.string() + " --out " + out.string() +
+                                       " >/dev/null 2>&1 & pid=$!; sleep 1; kill -INT -$pid; "
+                                       "wait $pid");
   int interrupted = 0, done = 0;
   for (const auto& e : std::filesystem::directory_iterator(out / "variants")) {
     if (!std::filesystem::exists(e.path() / "summary.json")) continue;

@@ -14,28 +14,17 @@ namespace {
 /// Run the vibrating bar for a very long time in the background, send `signals` (e.g. "INT" or
 /// "INT INT") after `delay` seconds and return the exit code.
 int run_and_signal(const std::filesystem::path& out, const std::string& signals, double delay) {
-  const auto rc = out.string() + ".rc";
   std::string kills;
   for (size_t a = 0, b; a < signals.size(); a = b + 1) {
     b = signals.find(' ', a);
     if (b == std::string::npos) b = signals.size();
     kills += "kill -" + signals.substr(a, b - a) + " $pid; ";
   }
-  const std::string cmd = std::string("bash -c '") + LOAM_EXE + " run " + LOAM_SOURCE_DIR +
-                          "/configs/vibrating_bar.yaml --quiet --threads 1 --set time.end=1e5 "
-                          "--out " +
-                          out.string() + " 2>/dev/null & pid=$!; sleep " + std::to_string(delay) +
-                          "; " + kills + "wait $pid; echo $? > " + rc + "'";
-  REQUIRE(std::system(cmd.c_str()) == 0);
-  int code = -1;
-  std::ifstream(rc) >> code;
-  return code;
-}
-
-bool has_tmp(const std::filesystem::path& dir) {
-  for (const auto& e : std::filesystem::directory_iterator(dir))
-    if (e.path().extension() == ".tmp") return true;
-  return false;
+  return loam_test::run_bash(std::string(LOAM_EXE) + " run " + LOAM_SOURCE_DIR +
+                             "/configs/vibrating_bar.yaml --quiet --threads 1 --set time.end=1e5 "
+                             "--out " +
+                             out.string() + " 2>/dev/null & pid=$!; sleep " +
+                             std::to_string(delay) + "; " + kills + "wait $pid");
 }
 
 }  // namespace
@@ -75,7 +64,7 @@ TEST_CASE("SIGINT and SIGTERM stop a run after its step with every file complete
     std::snprintf(after, sizeof after, "particles_%06ld.h5", frames);
     CHECK(!std::filesystem::exists(dir.path / after));  // no frame outside the index
     CHECK(last_row == steps);
-    CHECK(!has_tmp(dir.path));
+    CHECK(!loam_test::has_tmp_files(dir.path));
   }
 }
 
@@ -87,5 +76,5 @@ TEST_CASE("a second signal stops at once and leaves no temporary file", "[interr
   std::printf("SIGINT twice: exit %d, summary %s\n", code,
               std::filesystem::exists(dir.path / "summary.json") ? "written" : "not written");
   CHECK(code == 130);
-  CHECK(!has_tmp(dir.path));
+  CHECK(!loam_test::has_tmp_files(dir.path));
 }

@@ -42,8 +42,7 @@ TEST_CASE("a run writes XDMF frames, probes, history and a complete summary", "[
   while (std::getline(probe, line)) ++rows;
   CHECK(rows == s["steps"].get<long>() + 1);
   // No temporary files are left behind.
-  for (const auto& e : std::filesystem::directory_iterator(dir.path))
-    CHECK(e.path().extension() != ".tmp");
+  CHECK(!loam_test::has_tmp_files(dir.path));
   // A run without a reference still has verify: an empty map (the agreed field list).
   TempDir plain("output_plain");
   auto p = run_loam(std::string("run ") + LOAM_SOURCE_DIR +
@@ -204,15 +203,11 @@ TEST_CASE("a file that cannot be written stops the run with exit 4, naming it, t
   // OS error; the frames the index lists, the history and summary.json (status write_failed)
   // are complete; no .tmp file is left.
   TempDir dir("write_failure");
-  const std::string cmd = std::string("bash -c 'ulimit -f 64; ") + LOAM_EXE + " run " +
-                          LOAM_SOURCE_DIR +
-                          "/configs/vibrating_bar.yaml --quiet --threads 1 --set time.end=1e5 "
-                          "--set \"probes=[]\" --out " +
-                          dir.path.string() + " 2>" + dir.path.string() + ".err; echo $? > " +
-                          dir.path.string() + ".rc'";
-  REQUIRE(std::system(cmd.c_str()) == 0);
-  int code = -1;
-  std::ifstream(dir.path.string() + ".rc") >> code;
+  const int code = loam_test::run_bash(
+      "ulimit -f 64; " + std::string(LOAM_EXE) + " run " + LOAM_SOURCE_DIR +
+      "/configs/vibrating_bar.yaml --quiet --threads 1 --set time.end=1e5 --set \"probes=[]\" "
+      "--out " +
+      dir.path.string() + " 2>" + dir.path.string() + ".err");
   const std::string err = slurp(dir.path.string() + ".err");
   std::printf("exit %d: %s", code, err.c_str());
   CHECK(code == 4);
@@ -238,8 +233,6 @@ TEST_CASE("a file that cannot be written stops the run with exit 4, naming it, t
   while (std::getline(hist, line)) last = line, ++rows;
   CHECK(rows > 1);
   CHECK(std::stol(last.substr(0, last.find(','))) <= s["steps"].get<long>());
-  for (const auto& e : std::filesystem::directory_iterator(dir.path))
-    CHECK(e.path().extension() != ".tmp");
-  std::filesystem::remove(dir.path.string() + ".rc");
+  CHECK(!loam_test::has_tmp_files(dir.path));
   std::filesystem::remove(dir.path.string() + ".err");
 }
