@@ -169,6 +169,13 @@ TEST_CASE(
   std::printf("%s", other.output.c_str());
   CHECK(other.exit_code == 2);
   CHECK(other.output.find("belongs to another configuration") != std::string::npos);
+  auto keep_only = loam_test::run_loam("run " + cfg + " --quiet --out " + (a.path / "k").string() +
+                                       " --set 'output.checkpoint={keep: 3}'");
+  std::printf("%s", keep_only.output.c_str());
+  CHECK(keep_only.exit_code == 2);
+  CHECK(keep_only.output.find(":1:1: error: output.checkpoint: give every_steps or "
+                              "every_wall_seconds (or both)") != std::string::npos);
+  CHECK(!fs::exists(a.path / "k"));
   auto none =
       loam_test::run_loam("run " + cfg + " --quiet --resume " + (a.path / "nothing").string() + ck);
   CHECK(none.exit_code == 2);

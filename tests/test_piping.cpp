@@ -134,8 +134,8 @@ time: {end: 1}
 }
 
 TEST_CASE("slip box and sheet_pile_seepage: located errors", "[piping][cli]") {
-  // A slip box needs directions (a box has no normal); the exit window must span two cell
-  // rows; sheet_pile_seepage needs a 2D or 3D run.
+  // A slip box needs directions (a box has no normal); a reservoir level lies inside its box;
+  // the exit window must span two cell rows.
   loam_test::TempDir dir("piping_bad");
   const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/seed000_piping.yaml";
   auto r = loam_test::run_loam("run " + cfg + " --quiet --out " + (dir.path / "a").string() +
@@ -144,6 +144,14 @@ TEST_CASE("slip box and sheet_pile_seepage: located errors", "[piping][cli]") {
   CHECK(r.exit_code == 2);
   CHECK(r.output.find("error: boundaries.3: a box has no normal: give directions (e.g. [x])") !=
         std::string::npos);
+  auto l = loam_test::run_loam("run " + cfg + " --quiet --out " + (dir.path / "l").string() +
+                               " --set sources.0.level=9");
+  std::printf("%s", l.output.c_str());
+  CHECK(l.exit_code == 2);
+  CHECK(l.output.find(
+            ":1:1: error: sources.0.level: level 9 is outside the box along axis 1 [4, 7.75]") !=
+        std::string::npos);
+  CHECK(!std::filesystem::exists(dir.path / "l"));
   auto w = loam_test::run_loam("run " + cfg + " --quiet --out " + (dir.path / "b").string() +
                                " --set grid.cell_size=0.5");
   std::printf("%s", w.output.c_str());
