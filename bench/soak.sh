@@ -8,11 +8,14 @@ cd "$(dirname "$0")/.."
 LOAM=${1:-build/loam}
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
-# The 1D vibrating bar: about 0.0099 s per step, so 10^6 steps are t = 9 901 s; frames and
-# history sparse so that the output does not dominate.
-"$LOAM" run configs/vibrating_bar.yaml --threads 1 --out "$OUT/run" \
-  --set time.end=9901 --set output.every_time=990 --set output.history_every=10000 \
-  --set 'probes=[]' >"$OUT/log" 2>&1 &
+# The 1D vibrating bar on 0.05 m cells (1000 points): 4.95e-4 s per step, so 10^6 steps are
+# t = 495 s (about 100 s of wall time), long enough for the progress lines (every 3 s) to show
+# a trend and for the set-up to be negligible in a run of 10^4 steps; frames and history
+# sparse so that the output does not dominate.
+BAR=(configs/vibrating_bar.yaml --threads 1 --set grid.cell_size=0.05
+  --set output.history_every=10000 --set 'probes=[]')
+"$LOAM" run "${BAR[@]}" --out "$OUT/run" --set time.end=495.05 \
+  --set output.every_time=49.5 >"$OUT/log" 2>&1 &
 pid=$!
 rss=()
 while kill -0 "$pid" 2>/dev/null; do
@@ -21,19 +24,27 @@ while kill -0 "$pid" 2>/dev/null; do
   sleep 1
 done
 wait "$pid"
-"$LOAM" run configs/vibrating_bar.yaml --threads 1 --out "$OUT/short" --quiet \
-  --set time.end=99.01 --set output.every_time=9.9 --set output.history_every=10000 \
-  --set 'probes=[]'
+"$LOAM" run "${BAR[@]}" --out "$OUT/short" --quiet --set time.end=4.9505 \
+  --set output.every_time=0.495
 short=$(python3 -c "import json; print(json.load(open('$OUT/short/summary.json'))['particle_steps_per_second'])")
 long=$(python3 -c "import json; print(json.load(open('$OUT/run/summary.json'))['particle_steps_per_second'])")
 steps=$(python3 -c "import json; print(json.load(open('$OUT/run/summary.json'))['steps'])")
-python3 - "$short" "$long" "$steps" "${rss[@]}" <<'PY'
-import sys
+python3 - "$short" "$long" "$steps" "$OUT/log" "${rss[@]}" <<'PY'
+import re, statistics, sys
 short, long, steps = float(sys.argv[1]), float(sys.argv[2]), int(sys.argv[3])
-rss = [int(x) for x in sys.argv[4:]]
+rss = [int(x) for x in sys.argv[5:]]
 print(f"steps: {steps}")
 print(f"particle-steps/s: {long:.4g} over 10^6 steps, {short:.4g} over the first 10^4 "
       f"({100 * (long / short - 1):+.1f} %; limit 10 %)")
+# The progress lines' steps/s over each 3 s interval of the long run: the median of its first
+# three intervals against its last three (a slow-down within the run, not the host's drift
+# between two runs).
+rates = [float(m.group(1)) for m in
+         re.finditer(r"step \d+\s+([0-9.e+]+) steps/s", open(sys.argv[4]).read())]
+if len(rates) >= 6:
+    first, last = statistics.median(rates[:3]), statistics.median(rates[-3:])
+    print(f"steps/s within the run: {first:.4g} in its first three 3-s intervals, {last:.4g} in "
+          f"its last three ({100 * (last / first - 1):+.1f} %)")
 if len(rss) >= 3:
     start, end = rss[1], rss[-1]  # the first sample may precede the set-up
     print(f"RSS: {start} kB near the start, {end} kB at the end ({100 * (end / start - 1):+.1f} %; limit 5 %)")

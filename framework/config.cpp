@@ -150,8 +150,9 @@ Schema config_schema() {
         .min(1);
     n.boolean("keep_last_good",
               "keep a copy of the particles at each passed check, written as the last regular "
-              "frame when a later step fails (the failed state goes to a 'failed' frame); false "
-              "saves the copy's memory (about the particles' own)")
+              "frame (and, with output.checkpoint, checkpoint) when a later step fails (the "
+              "failed state goes to a 'failed' frame); false saves the copy's memory (about the "
+              "particles' own)")
         .def("true");
     s.section("numerics", n, "numerical controls");
   }

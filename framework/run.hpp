@@ -114,7 +114,23 @@ class Run {
   fs::path resume_file_;               // --resume: the checkpoint to continue from
   std::string resume_writer_state_;    // its writer state, restored once the writer is open
   std::string checkpoint_problem() const;
-  void write_checkpoint();
+  bool checkpointing() const { return checkpoint_every_ > 0 || checkpoint_wall_ > 0; }
+  /// What a checkpoint holds besides the particles (the run's scalars, the writer's frame list,
+  /// the plugins' state), taken when the particles passed the check: the image of the last
+  /// good state is kept until a later step fails and is then written with its particles.
+  struct CheckpointImage {
+    long step = -1;
+    std::vector<std::pair<std::string, double>> scalars;
+    std::vector<double> momentum;
+    std::string writer;
+    std::vector<std::pair<std::string, std::vector<double>>> plugins;
+  };
+  CheckpointImage good_image_;
+  template <class F>
+  void for_each_checkpoint_scalar(F&& f);
+  CheckpointImage checkpoint_image();
+  /// The checkpoint of `image` with the current particles; returns its file.
+  fs::path write_checkpoint(const CheckpointImage& image);
   void restore_checkpoint();
   std::string find_resume_checkpoint();
 

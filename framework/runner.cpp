@@ -144,38 +144,64 @@ std::string Run<D>::checkpoint_problem() const {
   return "";
 }
 
+/// The run's scalars a checkpoint holds besides the particles, each with where it lives: the
+/// one list write and restore go through. f(name, value&) for every one.
 template <int D>
-void Run<D>::write_checkpoint() {
+template <class F>
+void Run<D>::for_each_checkpoint_scalar(F&& f) {
+  Simulation<D>& sim = *sim_;
+  f("sim.time", sim.time);
+  f("sim.step", sim.step);
+  f("sim.dt", sim.dt);
+  f("sim.max_speed", sim.max_speed);
+  f("sim.created", sim.created);
+  f("sim.removed", sim.removed);
+  f("sim.mass_created", sim.mass_created);
+  f("sim.mass_removed", sim.mass_removed);
+  f("sim.initial_mass", sim.initial_mass);
+  f("sim.next_id", sim.next_particle_id());
+  f("run.frames", frames_);
+  f("run.next_frame_time", ls_.next_frame_time);
+  f("run.dt_first", ls_.dt_first);
+  f("run.dt_min", ls_.dt_min);
+  f("run.dt_max", ls_.dt_max);
+  f("run.frame_step", ls_.frame_step);
+  f("run.history_step", ls_.history_step);
+  f("run.e0.kinetic", ls_.e0.kinetic);
+  f("run.e0.strain", ls_.e0.strain);
+  f("run.e0.gravity", ls_.e0.gravity);
+}
+
+template <int D>
+typename Run<D>::CheckpointImage Run<D>::checkpoint_image() {
+  CheckpointImage image;
+  image.step = sim_->step;
+  for_each_checkpoint_scalar(
+      [&](const char* name, auto& v) { image.scalars.emplace_back(name, double(v)); });
+  image.momentum = ls_.e0.momentum;
+  image.writer = writer_->state();
+  const Simulation<D>& sim = *sim_;
+  std::vector<double> state;
+  if (sim.reference && sim.reference->save_state(state))
+    image.plugins.emplace_back("plugin.reference", state);
+  for (size_t i = 0; i < sim.sources.size(); ++i)
+    if (state.clear(), sim.sources[i]->save_state(state))
+      image.plugins.emplace_back("plugin.source." + std::to_string(i), state);
+  return image;
+}
+
+template <int D>
+fs::path Run<D>::write_checkpoint(const CheckpointImage& image) {
   const Simulation<D>& sim = *sim_;
   char name[64];
-  std::snprintf(name, sizeof name, "checkpoint_%08ld.h5", sim.step);
+  std::snprintf(name, sizeof name, "checkpoint_%08ld.h5", image.step);
   const fs::path file = dir_ / name;
   CheckpointWriter w(file.string());
   w.text("meta.format", "loam checkpoint 1");
   w.text("meta.version", loam_version() + " " + git_commit());
   w.text("meta.config", cfg_.params.to_json().dump());
-  for (const auto& [k, v] : {std::pair<const char*, double>{"sim.time", sim.time},
-                             {"sim.step", double(sim.step)},
-                             {"sim.dt", sim.dt},
-                             {"sim.max_speed", sim.max_speed},
-                             {"sim.created", double(sim.created)},
-                             {"sim.removed", double(sim.removed)},
-                             {"sim.mass_created", sim.mass_created},
-                             {"sim.mass_removed", sim.mass_removed},
-                             {"sim.initial_mass", sim.initial_mass},
-                             {"sim.next_id", double(sim_->next_particle_id())},
-                             {"run.frames", double(frames_)},
-                             {"run.next_frame_time", ls_.next_frame_time},
-                             {"run.dt_first", ls_.dt_first},
-                             {"run.dt_min", ls_.dt_min},
-                             {"run.dt_max", ls_.dt_max},
-                             {"run.frame_step", double(ls_.frame_step)},
-                             {"run.history_step", double(ls_.history_step)},
-                             {"run.e0.kinetic", ls_.e0.kinetic},
-                             {"run.e0.strain", ls_.e0.strain},
-                             {"run.e0.gravity", ls_.e0.gravity}})
-    w.scalar(k, v);
-  w.doubles("run.e0.momentum", ls_.e0.momentum);
+  for (const auto& [k, v] : image.scalars) w.scalar(k, v);
+  w.doubles("run.e0.momentum", image.momentum);
   for (size_t k = 0; k < sim.sets.size(); ++k) {
     const ParticleSet<D>& set = sim.sets[k];
     const Particles<D>& P = set.particles;
@@ -208,12 +234,8 @@ void Run<D>::write_checkpoint() {
     }
     w.doubles(pre + "partition", part);
   }
-  w.text("run.writer", writer_->state());
-  std::vector<double> state;
-  if (sim.reference && sim.reference->save_state(state)) w.doubles("plugin.reference", state);
-  for (size_t i = 0; i < sim.sources.size(); ++i)
-    if (state.clear(), sim.sources[i]->save_state(state))
-      w.doubles("plugin.source." + std::to_string(i), state);
+  w.text("run.writer", image.writer);
+  for (const auto& [k, v] : image.plugins) w.doubles(k, v);
   w.close();
   checkpoints_.push_back(file);
   while (int(checkpoints_.size()) > checkpoint_keep_) {
@@ -221,31 +243,15 @@ void Run<D>::write_checkpoint() {
     fs::remove(checkpoints_.front(), ec);
     checkpoints_.erase(checkpoints_.begin());
   }
+  return file;
 }
 
 template <int D>
 void Run<D>::restore_checkpoint() {
   Simulation<D>& sim = *sim_;
   CheckpointReader r(resume_file_.string());
-  sim.time = r.scalar("sim.time");
-  sim.step = long(r.scalar("sim.step"));
-  sim.dt = r.scalar("sim.dt");
-  sim.max_speed = r.scalar("sim.max_speed");
-  sim.created = size_t(r.scalar("sim.created"));
-  sim.removed = size_t(r.scalar("sim.removed"));
-  sim.mass_created = r.scalar("sim.mass_created");
-  sim.mass_removed = r.scalar("sim.mass_removed");
-  sim.initial_mass = r.scalar("sim.initial_mass");
-  sim.next_particle_id() = uint32_t(r.scalar("sim.next_id"));
-  ls_.next_frame_time = r.scalar("run.next_frame_time");
-  ls_.dt_first = r.scalar("run.dt_first");
-  ls_.dt_min = r.scalar("run.dt_min");
-  ls_.dt_max = r.scalar("run.dt_max");
-  ls_.frame_step = long(r.scalar("run.frame_step"));
-  ls_.history_step = long(r.scalar("run.history_step"));
-  ls_.e0.kinetic = r.scalar("run.e0.kinetic");
-  ls_.e0.strain = r.scalar("run.e0.strain");
-  ls_.e0.gravity = r.scalar("run.e0.gravity");
+  for_each_checkpoint_scalar(
+      [&](const char* name, auto& v) { v = std::remove_reference_t<decltype(v)>(r.scalar(name)); });
   ls_.e0.momentum = r.doubles("run.e0.momentum");
   for (size_t k = 0; k < sim.sets.size(); ++k) {
     ParticleSet<D>& set = sim.sets[k];
@@ -298,7 +304,6 @@ void Run<D>::restore_checkpoint() {
     sim.sources[i]->restore_state(r.doubles("plugin.source." + std::to_string(i)));
   // The writer's frame list comes back once the writer is open (loop()).
   resume_writer_state_ = r.text("run.writer");
-  frames_ = long(r.scalar("run.frames"));
   // The checkpoints of the run so far, and none from beyond this one (that future is redone).
   for (const auto& file : checkpoint_files(dir_)) {
     if (checkpoint_step(file) > sim.step) {
@@ -434,8 +439,12 @@ RunResult Run<D>::loop() {
   long steps_at_report = 0;
   const double t_end = sim.end_time;
   const double min_dt_ratio = cfg_.params.section("time").real("min_dt_ratio");
-  int interrupted = 0;                           // the signal that stopped the run (InterruptGuard)
-  if (sim.keep_last_good) sim.save_last_good();  // t = 0 (or the checkpoint) passed the checks
+  int interrupted = 0;  // the signal that stopped the run (InterruptGuard)
+  // The state at t = 0 (or the checkpoint) passed the checks. With checkpoints, the run's own
+  // state is kept beside the particles' (good_image_), for a checkpoint of the last good state.
+  const bool keep_good_image = files && sim.keep_last_good && checkpointing();
+  if (sim.keep_last_good) sim.save_last_good();
+  if (keep_good_image) good_image_ = checkpoint_image();
   while (write_error.empty() && sim.time < t_end * (1 - 1e-12) &&
          (opt_.max_steps < 0 || sim.step < opt_.max_steps)) {
     double dt = sim.stable_dt();
@@ -459,7 +468,14 @@ RunResult Run<D>::loop() {
         files && ((every_steps && next_step % every_steps == 0) ||
                   (every_time > 0 && next_time >= ls_.next_frame_time * (1 - 1e-9)));
     const bool last = next_time >= t_end * (1 - 1e-12) || next_step == opt_.max_steps;
-    if (!sim.advance(dt, frame_due || last)) {
+    // A checkpoint is written only of a state that passed the check.
+    const bool checkpoint_due =
+        files && !last &&
+        ((checkpoint_every_ > 0 && next_step % checkpoint_every_ == 0) ||
+         (checkpoint_wall_ > 0 &&
+          std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >=
+              checkpoint_wall_));
+    if (!sim.advance(dt, frame_due || last || checkpoint_due)) {
       failure = sim.failure;
       break;
     }
@@ -484,14 +500,11 @@ RunResult Run<D>::loop() {
           write_history();
           ls_.history_step = sim.step;
         }
-        const bool due = (checkpoint_every_ > 0 && sim.step % checkpoint_every_ == 0) ||
-                         (checkpoint_wall_ > 0 &&
-                          std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >=
-                              checkpoint_wall_);
-        if (due && !last) {
-          write_checkpoint();
+        if (checkpoint_due) {
+          write_checkpoint(checkpoint_image());
           last_checkpoint = Clock::now();
         }
+        if (keep_good_image && sim.last_good.step == sim.step) good_image_ = checkpoint_image();
       });
     if (!write_error.empty()) break;
     auto now = Clock::now();
@@ -513,7 +526,7 @@ RunResult Run<D>::loop() {
       if (ls_.frame_step != sim.step) write_frame("");
       sample_probes(true);
       if (ls_.history_step != sim.step) write_history();
-      if (checkpoint_every_ > 0 || checkpoint_wall_ > 0) write_checkpoint();
+      if (checkpointing()) write_checkpoint(checkpoint_image());
     });
   double wall = std::chrono::duration<double>(Clock::now() - t0).count();
   res.summary = base_summary();
@@ -565,16 +578,29 @@ RunResult Run<D>::loop() {
     if (files) {
       // The last state that passed the check as the last regular frame (unless it is one
       // already), then the state at detection as 'failed'.
+      // With checkpoints also as a checkpoint (unless the newest is of that step already).
       const auto& good = sim.last_good;
       if (good.step >= 0) {
-        if (good.step != ls_.frame_step) {
+        const bool frame = good.step != ls_.frame_step;
+        const bool checkpoint =
+            keep_good_image && good_image_.step == good.step &&
+            (checkpoints_.empty() || checkpoint_step(checkpoints_.back()) < good.step);
+        if (frame || checkpoint) {
           sim.swap_last_good();
-          guarded([&] { write_frame(""); });
+          guarded([&] {
+            if (frame) write_frame("");
+            if (checkpoint) write_checkpoint(good_image_);
+          });
           sim.swap_last_good();
         }
         res.summary["last_good"] = {{"step", good.step}, {"time", good.time}};
         written = "; the last state that passed the check (step " + std::to_string(good.step) +
                   ", t = " + format_number(good.time) + " s) is the last regular frame";
+        if (keep_good_image && !checkpoints_.empty() &&
+            checkpoint_step(checkpoints_.back()) == good.step) {
+          res.summary["last_good"]["checkpoint"] = checkpoints_.back().filename().string();
+          written += " and " + checkpoints_.back().filename().string();
+        }
       }
       guarded([&] { write_frame("failed"); });
       written += "; the state at detection was written as the frame labelled 'failed'";

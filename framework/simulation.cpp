@@ -41,9 +41,10 @@ bool Simulation<D>::advance(double step_dt, bool check) {
     bool ok = true;
     timed("check_particles", [&] { ok = check_particles(failure); });
     if (!ok) return false;
-    if (keep_last_good) timed("last_good_copy", [&] { save_last_good(); });
   }
   timed("partition", [&] { maintain_partition(); });
+  if ((check || step % check_every == 0) && keep_last_good)
+    timed("last_good_copy", [&] { save_last_good(); });
   return true;
 }
 
@@ -78,16 +79,39 @@ void Simulation<D>::check_grid(const GridUpdate& u) {
 template <int D>
 void Simulation<D>::save_last_good() {
   last_good.time = time;
+  last_good.dt = dt;
+  last_good.max_speed = max_speed;
   last_good.step = step;
   last_good.sets.resize(sets.size());
-  for (size_t k = 0; k < sets.size(); ++k) sets[k].particles.copy_to(last_good.sets[k], threads);
+  last_good.layouts.resize(sets.size());
+  for (size_t k = 0; k < sets.size(); ++k) {
+    const ParticleSet<D>& s = sets[k];
+    s.particles.copy_to(last_good.sets[k], threads);
+    auto& l = last_good.layouts[k];
+    l.slabs = s.partition.slabs;
+    l.material_ranges = s.partition.material_ranges;
+    l.threads = s.partition.threads;
+    l.last_sort = s.last_sort;
+    l.resized = s.resized;
+  }
 }
 
 template <int D>
 void Simulation<D>::swap_last_good() {
   std::swap(time, last_good.time);
+  std::swap(dt, last_good.dt);
+  std::swap(max_speed, last_good.max_speed);
   std::swap(step, last_good.step);
-  for (size_t k = 0; k < sets.size(); ++k) std::swap(sets[k].particles, last_good.sets[k]);
+  for (size_t k = 0; k < sets.size(); ++k) {
+    ParticleSet<D>& s = sets[k];
+    auto& l = last_good.layouts[k];
+    std::swap(s.particles, last_good.sets[k]);
+    std::swap(s.partition.slabs, l.slabs);
+    std::swap(s.partition.material_ranges, l.material_ranges);
+    std::swap(s.partition.threads, l.threads);
+    std::swap(s.last_sort, l.last_sort);
+    std::swap(s.resized, l.resized);
+  }
 }
 
 template <int D>

@@ -150,17 +150,26 @@ class Simulation {
   void check_grid(const GridUpdate& u);
 
   /// The state of the last step that passed the stability check (numerics.keep_last_good): the
-  /// runner writes it as the last regular frame when a later step fails.
+  /// runner writes it as the last regular frame (and checkpoint) when a later step fails. Each
+  /// set's particles with the partition they were sorted into, so that a checkpoint of it
+  /// continues as the run did.
   struct GoodState {
-    double time = 0;
+    double time = 0, dt = 0, max_speed = 0;
     long step = -1;
     std::vector<Particles<D>> sets;
+    struct Layout {  // a set's partition (not its sort scratch) and sort counters
+      std::vector<typename Partition<D>::Slab> slabs;
+      std::vector<IndexRange> material_ranges;
+      int threads = 1;
+      long last_sort = 0;
+      bool resized = false;
+    };
+    std::vector<Layout> layouts;
   };
   GoodState last_good;
   bool keep_last_good = true;
   void save_last_good();
-  /// Exchange the particles and time of the last good state with the current ones (twice:
-  /// back).
+  /// Exchange the last good state with the current one (twice: back).
   void swap_last_good();
   /// The material stress update of one block [b, b + count) (one material per block), with
   /// its velocity gradient L in block layout (MaterialBatch).

@@ -74,6 +74,7 @@
 #include <cmath>
 #include <memory>
 
+#include "framework/cell_sums.hpp"
 #include "framework/drag.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
@@ -193,7 +194,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         P.col(P.mass)[i] *= 1 - n0_;
         P.col(contact_)[i] = 1;
       } else {
-        const double n = cell_porosity(cell_index(sim.grid, P, i));
+        const double n = cell_porosity(particle_cell(sim.grid, P, i));
         P.col(n_)[i] = n;
         P.col(P.volume)[i] *= n;
         P.col(P.mass)[i] *= n;
@@ -321,17 +322,11 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     // Also without liquid bodies: the sources at t = 0 re-mass their points with it.
     cell_solid_.assign(sim.grid.num_cells, 0.0);
     for (size_t i = 0; i < solid.size(); ++i)
-      cell_solid_[cell_index(sim.grid, solid, i)] +=
+      cell_solid_[particle_cell(sim.grid, solid, i)] +=
           (1 - solid.col(n_)[i]) * solid.col(solid.volume)[i];
     initialize_particles(sim, sim.sets[kLiquid], 0, liquid.size());
   }
 
-  static size_t cell_index(const Grid<D>& g, const Particles<D>& P, size_t i) {
-    size_t c = 0;
-    for (int d = 0; d < D; ++d)
-      c += size_t(g.cell_of(P.col(P.position, d)[i], d)) * size_t(g.cell_stride[d]);
-    return c;
-  }
   /// Porosity of grid cell c from the solid volume in it, n_c = 1 - V_s,c / V_c in
   /// [kMinPorosity, 1]: the water fraction of a cell whose pores are full. A liquid point's
   /// mixture volume is V / n_c, so the liquid points of a full cell integrate over the cell's
@@ -357,29 +352,21 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     liquid_cell_sums(sim, liquid_cell_, cell_liquid_, false);
   }
   /// Per grid cell the liquid points' volume sum (with_mass: mass then volume, 2 values) and
-  /// each point's cell. The sums are atomic: after a move two points of same-coloured slabs may
-  /// share a cell (one thread: the scatter's order, deterministic).
+  /// each point's cell, in point order (framework/cell_sums.hpp: bitwise the same at any thread
+  /// count).
   void liquid_cell_sums(Simulation<D>& sim, std::vector<size_t>& index, std::vector<double>& sums,
                         bool with_mass) const {
-    auto& set = sim.sets[kLiquid];
-    const Particles<D>& P = set.particles;
-    const size_t stride = with_mass ? 2 : 1;
-    sums.assign(sim.grid.num_cells * stride, 0.0);
-    index.resize(P.size());
+    const Particles<D>& P = sim.sets[kLiquid].particles;
     const double* m = P.col(P.mass);
     const double* V = P.col(P.volume);
-    set.scatter_blocks([&](size_t b, int count, int) {
-      for (size_t i = b; i < b + size_t(count); ++i) {
-        const size_t c = cell_index(sim.grid, P, i);
-        index[i] = c;
-        if (with_mass) {
-#pragma omp atomic
-          sums[2 * c] += m[i];
-        }
-#pragma omp atomic
-        sums[stride * c + stride - 1] += V[i];
-      }
-    });
+    if (with_mass)
+      sum_per_cell<2>(sim.grid, P, sim.threads, index, sums, [&](size_t i, double* v) {
+        v[0] = m[i];
+        v[1] = V[i];
+      });
+    else
+      sum_per_cell<1>(sim.grid, P, sim.threads, index, sums,
+                      [&](size_t i, double* v) { v[0] = V[i]; });
   }
 
   template <int NPP>
@@ -469,7 +456,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * P.col(P.stress, voigt_index(d, j))[i];
       }
       const double vq = V[p] * sc.Q[size_t(p)], vs = (1 - n[p]) * V[p];
-      cell_solid_[cell_index(sim.grid, P, i)] += vs;  // in the stencil: race-free
+      cell_solid_[particle_cell(sim.grid, P, i)] += vs;  // in the stencil: race-free
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];

@@ -55,6 +55,7 @@
 #include <cmath>
 #include <memory>
 
+#include "framework/cell_sums.hpp"
 #include "framework/drag.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
@@ -273,27 +274,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       for (long i = 0; i < np; ++i) p[i] += dp_[size_t(i)];
       return;
     }
-    const Grid<D>& grid = sim.grid;
-    auto cell_of = [&](size_t i) {
-      size_t c = 0;
-      for (int d = 0; d < D; ++d)
-        c += size_t(grid.cell_of(P.col(P.position, d)[i], d)) * size_t(grid.cell_stride[d]);
-      return c;
-    };
-    std::fill(cell_.begin(), cell_.end(), 0.0);
-    // The particles have moved since the partition was coloured: two of same-coloured slabs
-    // may now share a cell, so the sums are atomic (one thread: the same order as before).
-    cell_index_.resize(P.size());
-    sim.scatter_blocks([&](ParticleSet<D>&, size_t b, int count, int) {
-      for (size_t i = b; i < b + size_t(count); ++i) {
-        const size_t c = cell_of(i);
-        cell_index_[i] = c;
-        const double V = P.col(P.volume)[i];
-#pragma omp atomic
-        cell_[2 * c] += V * (p[i] + dp_[i]);
-#pragma omp atomic
-        cell_[2 * c + 1] += V;
-      }
+    const double* V = P.col(P.volume);
+    sum_per_cell<2>(sim.grid, P, sim.threads, cell_index_, cell_, [&](size_t i, double* v) {
+      v[0] = V[i] * (p[i] + dp_[i]);
+      v[1] = V[i];
     });
 #pragma omp parallel for schedule(static) num_threads(sim.threads)
     for (long i = 0; i < np; ++i) {

@@ -1,7 +1,7 @@
 // Checkpoint and resume (issue 14, deliverable 1; framework/checkpoint.hpp, runner.cpp): a run
 // resumed from a checkpoint taken between two output frames gives bitwise the frames, history,
 // probes, XDMF index and summary numbers of the uninterrupted run, for single_phase,
-// two_phase_single_point and (1 thread) two_phase_double_point, at 1 and 2 threads; an
+// two_phase_single_point and two_phase_double_point, at 1 and 2 threads; an
 // interrupted run (SIGINT through a real process) resumes to the uninterrupted final state; a
 // checkpoint of another configuration is refused; `keep` keeps the newest N.
 #include <catch2/catch.hpp>
@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 /// Every output file of run a equals run b's: frames (all datasets the test reads), history,
 /// probes, the XDMF index, and the summary's numbers (all keys but the wall-clock ones and the
 /// config file's path).
-void require_same_outputs(const fs::path& a, const fs::path& b) {
+void require_same_outputs(const fs::path& a, const fs::path& b, long min_frames = 3) {
   long frames = 0;
   for (const auto& e : fs::directory_iterator(a)) {
     const std::string n = e.path().filename().string();
@@ -36,7 +36,7 @@ void require_same_outputs(const fs::path& a, const fs::path& b) {
       CHECK(loam_test::read_frame_ids(e.path()) == loam_test::read_frame_ids(b / n));
     }
   }
-  CHECK(frames >= 3);
+  CHECK(frames >= min_frames);
   auto sa = nlohmann::json::parse(loam_test::slurp(a / "summary.json"));
   auto sb = nlohmann::json::parse(loam_test::slurp(b / "summary.json"));
   for (const char* k :
@@ -89,22 +89,66 @@ TEST_CASE("a resumed two-phase run is bitwise the uninterrupted one, 1 and 2 thr
         1000, 7000);
 }
 
-TEST_CASE("a resumed piping run (reservoir, sink, a series reference) is bitwise the same",
-          "[checkpoint][piping]") {
+TEST_CASE(
+    "a resumed piping run (reservoir, sink, a series reference) is bitwise the same 1 and 2 "
+    "threads",
+    "[checkpoint][piping]") {
   // configs/seed000_piping.yaml on 0.25 m cells to t = 1 s: the rising reservoir creates and
   // the region sink removes liquid points (ids, the mass balance), and sheet_pile_seepage
-  // accumulates its time series (verify.series, verify.csv) across the checkpoint.
-  check_resume("seed000_piping.yaml",
-               "--threads 1 --set grid.cell_size=0.25 --set time.end=1 "
-               "--set output.every_time=0.25",
-               500, 1500);
+  // accumulates its time series (verify.series, verify.csv) across the checkpoint. 2D, so at 2
+  // threads points of same-coloured slabs do share cells after the move.
+  for (const char* threads : {"1", "2"})
+    check_resume("seed000_piping.yaml",
+                 std::string("--threads ") + threads +
+                     " --set grid.cell_size=0.25 --set time.end=1 --set output.every_time=0.25",
+                 500, 1500);
 }
 
-TEST_CASE("a resumed double-point run is bitwise the uninterrupted one, 1 thread",
+TEST_CASE("a resumed double-point run is bitwise the uninterrupted one, 1 and 2 threads",
           "[checkpoint][double_point]") {
-  // Its cell sums are atomic, so only 1 thread is deterministic at all (docs/architecture.md).
-  check_resume("terzaghi_double_point.yaml",
-               "--threads 1 --set time.end=0.05 --set output.every_time=0.01", 1000, 4000);
+  // Its cell sums after the move run in point order (framework/cell_sums.hpp), so 2 threads are
+  // deterministic too.
+  for (const char* threads : {"1", "2"})
+    check_resume(
+        "terzaghi_double_point.yaml",
+        std::string("--threads ") + threads + " --set time.end=0.05 --set output.every_time=0.01",
+        1000, 4000);
+}
+
+TEST_CASE("an unstable run checkpoints its last good state and resuming it fails the same way",
+          "[checkpoint][stability]") {
+  // The seed-001 column with USL, k = 10 m/s and cfl 0.8 (above its critical 0.755,
+  // test_two_phase_mechanism.cpp) diverges at step 77, 2 threads. Checked every 10 steps and
+  // checkpointed every 50: the state after step 70 passed the last check, and is written as
+  // checkpoint_00000070.h5 beside the regular checkpoint of step 50 and named in the message
+  // and summary.json. Resumed from it, the run diverges at the same step with bitwise the same
+  // frames (the failed one included), history and summary: the checkpoint holds the particles,
+  // partition and run state of step 70, not a mix with the state at detection.
+  loam_test::TempDir a("lastgood_a"), b("lastgood_b");
+  const std::string args = std::string("run ") + LOAM_SOURCE_DIR +
+                           "/configs/seed001_terzaghi.yaml --quiet --threads 2 --set time.end=0.1 "
+                           "--set scheme.update=usl --set scheme.drag.hydraulic_conductivity=10 "
+                           "--set output.every_time=0.01 --set time.cfl=0.8 "
+                           "--set 'output.checkpoint={every_steps: 50, keep: 5}' ";
+  auto r = loam_test::run_loam(args + "--out " + a.path.string());
+  std::printf("%s", r.output.c_str());
+  REQUIRE(r.exit_code == 3);
+  CHECK(r.output.find("unstable run at step 77") != std::string::npos);
+  CHECK(r.output.find("the last state that passed the check (step 70, t = ") != std::string::npos);
+  CHECK(r.output.find(" s) is the last regular frame and checkpoint_00000070.h5; the state at "
+                      "detection was written as the frame labelled 'failed'") != std::string::npos);
+  auto sa = nlohmann::json::parse(loam_test::slurp(a.path / "summary.json"));
+  CHECK(sa["last_good"]["step"] == 70);
+  CHECK(sa["last_good"]["checkpoint"] == "checkpoint_00000070.h5");
+  CHECK(fs::exists(a.path / "checkpoint_00000050.h5"));
+  REQUIRE(fs::exists(a.path / "checkpoint_00000070.h5"));
+  fs::copy(a.path, b.path, fs::copy_options::recursive);
+  fs::remove(b.path / "summary.json");
+  auto s = loam_test::run_loam(args + "--resume " + (b.path / "checkpoint_00000070.h5").string());
+  std::printf("resumed from step 70: exit %d\n", s.exit_code);
+  CHECK(s.exit_code == 3);
+  CHECK(s.output == r.output);
+  require_same_outputs(a.path, b.path, 2);
 }
 
 TEST_CASE("an interrupted run resumes to the uninterrupted run's final state",
@@ -140,13 +184,14 @@ TEST_CASE("an interrupted run resumes to the uninterrupted run's final state",
   for (const char* field : {"position", "velocity", "stress"})
     CHECK(loam_test::read_frame_doubles(a.path / last_a, field) ==
           loam_test::read_frame_doubles(b.path / last_b, field));
-  // The history has one row more (the interruption's step) and otherwise the same rows.
+  // The history has one row more (the interruption's step, unless it is a multiple of the
+  // config's history_every of 10 steps, whose row is regular) and otherwise the same rows.
   std::ifstream ha(a.path / "history.csv"), hb(b.path / "history.csv");
   std::vector<std::string> rows_a, rows_b;
   for (std::string l; std::getline(ha, l);) rows_a.push_back(l);
   for (std::string l; std::getline(hb, l);) rows_b.push_back(l);
   CHECK(rows_a.back() == rows_b.back());
-  CHECK(rows_b.size() == rows_a.size() + 1);
+  CHECK(rows_b.size() == rows_a.size() + (interrupted["steps"].get<long>() % 10 != 0 ? 1 : 0));
 }
 
 TEST_CASE(
@@ -180,4 +225,24 @@ TEST_CASE(
       loam_test::run_loam("run " + cfg + " --quiet --resume " + (a.path / "nothing").string() + ck);
   CHECK(none.exit_code == 2);
   CHECK(none.output.find("no such directory or checkpoint file") != std::string::npos);
+  // A reference without save_state (tests/plugins/stateless_reference.cpp, loaded as an
+  // out-of-tree plugin): it runs, but a checkpointed run with it is refused before any output.
+  std::string bar = loam_test::slurp(cfg);
+  bar = "plugins: [" + std::string(LOAM_STATELESS_REFERENCE) + "]\n" +
+        bar.substr(0, bar.find("verify:")) + "verify: {type: test_peak_speed}\n";
+  const fs::path run_file = a.path / "stateless.yaml";
+  std::ofstream(run_file) << bar;
+  auto plain = loam_test::run_loam("run " + run_file.string() + " --quiet --threads 1 --out " +
+                                   (a.path / "plain").string());
+  INFO(plain.output);
+  REQUIRE(plain.exit_code == 0);
+  auto sp = nlohmann::json::parse(loam_test::slurp(a.path / "plain" / "summary.json"));
+  CHECK(sp["verify"]["peak_speed"].get<double>() > 0.09);  // v0 = 0.1 m/s at t = 0
+  auto refused = loam_test::run_loam("run " + run_file.string() + " --quiet --out " +
+                                     (a.path / "refused").string() + ck);
+  std::printf("%s", refused.output.c_str());
+  CHECK(refused.exit_code == 2);
+  CHECK(refused.output.find(": error: output.checkpoint: the reference 'test_peak_speed' cannot "
+                            "be checkpointed yet (its state is not saved)") != std::string::npos);
+  CHECK(!fs::exists(a.path / "refused"));
 }
