@@ -239,3 +239,46 @@ time: {end: 3}
   std::printf("6.5 m pool, pressure_smoothing none, 3 s: max |v| = %.2e m/s (limit 1e-2)\n", vmax);
   CHECK(vmax <= 1e-2);
 }
+
+TEST_CASE("sheet_pile_seepage: the exit gradient is the seepage i = n (w - v) / k in the window",
+          "[piping][reference]") {
+  // The mechanism of the measurement (plugins/references/sheet_pile_seepage.cpp): a saturated
+  // sand box (n = 0.43, Darcy k = 1e-2 m/s) with the pile at x = 2 m, the water moving up at
+  // w = 3 mm/s and the skeleton at v = 1 mm/s. The window's exit gradient is
+  // n (w - v) / k = 0.43 * 2e-3 / 1e-2 = 0.086 to round-off, whatever the pressures; water at
+  // rest on a skeleton at rest gives 0. A conductivity given in `verify:` replaces the drag's.
+  const std::string yaml = R"(
+grid: {origin: [0, 0], extent: [4, 3], cell_size: 0.25}
+gravity: [0, -9.81]
+scheme: {type: two_phase_double_point, porosity: 0.43,
+         drag: {type: darcy, hydraulic_conductivity: 1.0e-2}}
+bodies:
+  - {name: sand, set: solid, generator: {type: box, min: [0, 0], max: [4, 2]},
+     material: {type: linear_elastic, E: 1.0e8, nu: 0.3, density: 2650}}
+  - {name: water, set: liquid, generator: {type: box, min: [0, 0], max: [4, 2.5]},
+     material: {type: newtonian_fluid, bulk_modulus: 2.0e8, viscosity: 1.0e-3, density: 1000}}
+time: {end: 1}
+)";
+  auto sim = loam_test::make_simulation<2>(yaml);
+  const std::string verify = "{type: sheet_pile_seepage, body: sand, pile: 2, depth: 1, every: 1}";
+  auto measure = [&](double w, double v, const std::string& spec) {
+    for (int k = 0; k < 2; ++k) {
+      auto& P = sim->sets[size_t(k)].particles;
+      for (size_t i = 0; i < P.size(); ++i) P.col(P.velocity, 1)[i] = k == 0 ? v : w;
+    }
+    auto ref = loam_test::make_reference<2>(*sim, spec);
+    ref->sample(*sim);
+    return ref->series()[4].second.back();  // exit_gradient
+  };
+  const double moving = measure(3e-3, 1e-3, verify);
+  const double still = measure(0, 0, verify);
+  const double given =
+      measure(3e-3, 1e-3,
+              "{type: sheet_pile_seepage, body: sand, pile: 2, depth: 1, every: 1, "
+              "hydraulic_conductivity: 2.0e-2}");
+  std::printf("seepage exit gradient: %.6g (0.086), at rest %.3g (0), with k = 2e-2 %.6g (0.043)\n",
+              moving, still, given);
+  CHECK(moving == Approx(0.086).epsilon(1e-12));
+  CHECK(still == 0);
+  CHECK(given == Approx(0.043).epsilon(1e-12));
+}

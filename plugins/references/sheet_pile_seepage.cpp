@@ -14,13 +14,18 @@
 // What it measures, every `every` seconds:
 // - the head difference ΔH = h_up - h_down: the mean head p/γ_w + y of the pressure set's points
 //   within `head_band` above the soil surface, on each side, at least d/2 from the pile;
-// - the exit gradient: -dh/dy, the least-squares slope of the head of the points in the exit
-//   window (x_pile ≤ x ≤ x_pile + width, y_s - depth ≤ y ≤ y_s), over the cell means of
-//   pressure and position (a scheme may hold one pressure per cell); Harr's gradient is fitted
-//   the same way from his head field at the same cell centroids, so the window does not bias it;
+// - the exit gradient in the exit window (x_pile ≤ x ≤ x_pile + width, y_s - depth ≤ y ≤ y_s)
+//   from the seepage: i = n (w_y - v_y) / k, Darcy's law for the flux relative to the skeleton,
+//   i.e. the drag on the grains over γ_w, the force that lifts them (cell means of the liquid
+//   and solid points' vertical velocity and the solid porosity, averaged over the window's cells
+//   weighted by their liquid points), against Harr's -dh/dy averaged at the same cell centroids;
+// - the exit gradient from the pressures (series exit_gradient_pressure): -dh/dy, the
+//   least-squares slope of the cell-mean head over the window, Harr's fitted the same way. The
+//   liquid points' own pressures scatter by far more than their cell means (with linear hats a
+//   cell's nodal forces see only its sum of V p; docs/verification.md I), so this one is noisy;
 // - the fluidised points of the bed (a `contact` field of 0) downstream of the pile, and the heave:
 //   the rise of the highest grain of the bed within d/2 downstream of the pile.
-// Metrics: exit_gradient_error (the slope through the origin of the measured exit gradient
+// Metrics: exit_gradient_error (the slope through the origin of the seepage exit gradient
 // against Harr's over the intact samples with ΔH ≥ ΔH_c/4, minus 1), critical_head (ΔH at the
 // first sample with a fluidised grain downstream; NaN if none), critical_head_harr (π d i_c),
 // critical_head_prism, critical_head_error (against Harr), heave and fluidised_points at the
@@ -63,6 +68,10 @@ class SheetPileSeepage : public Reference<D> {
     s.real("head_band", "m",
            "height of the band above the soil surface where the side heads are measured "
            "(default: d/4)")
+        .positive();
+    s.real("hydraulic_conductivity", "m/s",
+           "Darcy k of the soil for the seepage exit gradient i = n (w - v) / k (default: "
+           "scheme.drag.hydraulic_conductivity of a darcy drag)")
         .positive();
     s.real("every", "s", "sampling interval").def("0.05").positive();
     return s;
@@ -107,6 +116,18 @@ class SheetPileSeepage : public Reference<D> {
       const double rho_s = b.params.section("material").real("density");
       i_c_ = (rho_s / params_.real("water_density") - 1) * (1 - scheme.real("porosity"));
     }
+    const Params& scheme = sim.config.section("scheme");
+    if (params_.has("hydraulic_conductivity")) {
+      k_ = params_.real("hydraulic_conductivity");
+    } else if (scheme.has("drag") && scheme.section("drag").type() == "darcy") {
+      k_ = scheme.section("drag").real("hydraulic_conductivity");
+    } else {
+      diag.error(params_.where(), params_.path(),
+                 "the scheme has no darcy drag: give hydraulic_conductivity");
+      return;
+    }
+    porosity_ = sim.particles_of_body(body_).find("porosity");
+    n0_ = scheme.has("porosity") ? scheme.real("porosity") : std::nan("");
     width_ = band_ = d_ / 4, depth_ = d_ / 2;
     if (params_.has("exit_window")) {
       const auto& w = params_.vec("exit_window");
@@ -174,8 +195,9 @@ class SheetPileSeepage : public Reference<D> {
     const bool fit = cells.size() >= 2 && var > 1e-12 * depth_ * depth_ * n;
     const double i_exit = fit ? -(syh - sy * sh / n) / var : std::nan("");
     const double i_harr = fit ? -(syhh - sy * shh / n) / var : std::nan("");
-    // Fluidised grains downstream and the heave next to the pile.
     const Particles<D>& S = sim.particles_of_body(body_);
+    const auto [i_seep, i_seep_harr] = seepage_exit_gradient(sim, P, S, dH);
+    // Fluidised grains downstream and the heave next to the pile.
     long fluidised = 0;
     if (S.has(contact_))
       for (size_t i = 0; i < S.size(); ++i)
@@ -185,8 +207,10 @@ class SheetPileSeepage : public Reference<D> {
     head_.push_back(dH);
     up_.push_back(h_up);
     down_.push_back(h_down);
-    exit_.push_back(i_exit);
-    harr_.push_back(i_harr);
+    exit_.push_back(i_seep);
+    harr_.push_back(i_seep_harr);
+    exit_p_.push_back(i_exit);
+    harr_p_.push_back(i_harr);
     fluidised_.push_back(double(fluidised));
     heave_.push_back(strip_top(sim) - heave_base_);
     if (fluidised > 0 && !std::isfinite(critical_)) critical_ = dH;
@@ -223,13 +247,16 @@ class SheetPileSeepage : public Reference<D> {
             {"head_downstream", down_},
             {"exit_gradient", exit_},
             {"exit_gradient_harr", harr_},
+            {"exit_gradient_pressure", exit_p_},
+            {"exit_gradient_pressure_harr", harr_p_},
             {"fluidised_points", fluidised_},
             {"heave", heave_}};
   }
 
   bool save_state(std::vector<double>& s) const override {
     s = {clock_.next, critical_, double(time_.size())};
-    for (const auto* v : {&time_, &head_, &up_, &down_, &exit_, &harr_, &fluidised_, &heave_})
+    for (const auto* v :
+         {&time_, &head_, &up_, &down_, &exit_, &harr_, &exit_p_, &harr_p_, &fluidised_, &heave_})
       s.insert(s.end(), v->begin(), v->end());
     return true;
   }
@@ -237,13 +264,56 @@ class SheetPileSeepage : public Reference<D> {
     clock_.next = s.at(0), critical_ = s.at(1);
     const long n = long(s.at(2));
     long k = 3;
-    for (auto* v : {&time_, &head_, &up_, &down_, &exit_, &harr_, &fluidised_, &heave_}) {
+    for (auto* v :
+         {&time_, &head_, &up_, &down_, &exit_, &harr_, &exit_p_, &harr_p_, &fluidised_, &heave_}) {
       v->assign(s.begin() + k, s.begin() + k + n);
       k += n;
     }
   }
 
  private:
+  /// The exit gradient from the seepage, i = n (w_y - v_y) / k, per cell of the exit window
+  /// (liquid points P: w_y; the soil's points S: v_y and n), averaged over the cells weighted by
+  /// their liquid points; and Harr's -dh/dy for the head difference dH (central difference)
+  /// averaged the same way at the cells' liquid centroids.
+  std::pair<double, double> seepage_exit_gradient(const Simulation<D>& sim, const Particles<D>& P,
+                                                  const Particles<D>& S, double dH) const {
+    // Per cell: liquid x, y, w_y, count; solid v_y, n, count.
+    std::map<std::array<long, D>, std::array<double, 7>> cells;
+    auto visit = [&](const Particles<D>& Q, size_t i, auto&& add) {
+      const double x = Q.col(Q.position, 0)[i], y = Q.col(Q.position, D - 1)[i];
+      if (x < x_pile_ || x > x_pile_ + width_ || y > surface_ || y < surface_ - depth_) return;
+      std::array<long, D> c{};
+      for (int d = 0; d < D; ++d)
+        c[size_t(d)] = long(std::floor((Q.col(Q.position, d)[i] - sim.grid.origin[size_t(d)]) *
+                                       sim.grid.inv_cell[size_t(d)]));
+      add(cells[c], x, y);
+    };
+    for (size_t i = 0; i < P.size(); ++i)
+      visit(P, i, [&](auto& a, double x, double y) {
+        a[0] += x, a[1] += y, a[2] += P.col(P.velocity, D - 1)[i], a[3] += 1;
+      });
+    for (size_t i = 0; i < S.size(); ++i)
+      if (S.body[i] == body_)
+        visit(S, i, [&](auto& a, double, double) {
+          a[4] += S.col(S.velocity, D - 1)[i];
+          a[5] += S.has(porosity_) ? S.col(porosity_)[i] : n0_;
+          a[6] += 1;
+        });
+    double sum = 0, sum_harr = 0, weight = 0;
+    const double dy = 1e-4 * d_;
+    for (const auto& [c, a] : cells) {
+      if (a[3] == 0 || a[6] == 0) continue;
+      const double xc = a[0] / a[3] - x_pile_, yc = a[1] / a[3] - surface_;
+      const double i = a[5] / a[6] * (a[2] / a[3] - a[4] / a[6]) / k_;
+      const double i_harr =
+          -(harr_head_fraction(xc, yc + dy, d_) - harr_head_fraction(xc, yc - dy, d_)) / (2 * dy);
+      sum += a[3] * i, sum_harr += a[3] * i_harr, weight += a[3];
+    }
+    if (!(weight > 0)) return {std::nan(""), std::nan("")};
+    return {sum / weight, dH * sum_harr / weight};
+  }
+
   /// Terzaghi's prism: the mean of Harr's excess head fraction on its base (depth d, from the
   /// pile to d/2 downstream), by Simpson's rule on 200 intervals.
   double prism_mean_head() const {
@@ -275,6 +345,10 @@ class SheetPileSeepage : public Reference<D> {
   double critical_ = std::nan("");
   int body_ = -1, set_ = -1, pressure_ = -1, contact_ = -1;
   std::vector<double> time_, head_, up_, down_, exit_, harr_, fluidised_, heave_;
+  std::vector<double> exit_p_, harr_p_;  // the exit gradient from the pressures, and Harr's
+  double k_ = 0;                         // Darcy hydraulic conductivity (m/s)
+  int porosity_ = -1;                    // the soil points' porosity field
+  double n0_ = 0;                        // scheme.porosity, if the soil has no porosity field
 };
 
 LOAM_REGISTER(Reference, SheetPileSeepage)
