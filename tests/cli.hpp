@@ -19,15 +19,20 @@ struct CliResult {
   std::string output;  // stdout and stderr
 };
 
-inline CliResult run_loam(const std::string& args) {
+/// Run a shell command; its exit code and its stdout and stderr together.
+inline CliResult run_command(const std::string& command) {
   CliResult r;
-  std::string cmd = std::string(LOAM_EXE) + " " + args + " 2>&1";
+  const std::string cmd = command + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   char buf[4096];
   while (size_t n = fread(buf, 1, sizeof buf, pipe)) r.output.append(buf, n);
   int status = pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+inline CliResult run_loam(const std::string& args) {
+  return run_command(std::string(LOAM_EXE) + " " + args);
 }
 
 /// Columns of a CSV file written by loam (probe_*.csv, history.csv) by header name; empty if the
