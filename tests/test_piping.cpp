@@ -289,12 +289,17 @@ TEST_CASE("seed 000 piping scene: the exit gradient follows Harr's and the bed h
           "[piping][scene][full]") {
   // configs/seed000_piping.yaml as shipped (0.125 m cells, GIMP, 8 s, about 4 min on 2
   // threads; docs/verification.md I). References: Harr's exit gradient measured at the same
-  // cells as the seepage i = n (w - v) / k next to the pile. Tolerance: exit_gradient_error
-  // within +-0.15, the size of the reference's own bias for this pile (a 0.25 m thick pile gives
-  // 0.863 of Harr's thin-pile gradient in a Laplace solve); measured -0.006 (2026-12-02). The
-  // bed next to the pile stays put while dH < 2 m (heave < 0.1 mm) and rises once dH passes
-  // the critical heads (2.66 m prism, 2.95 m exit gradient): heave > 1 mm at 8 s (measured
-  // 2.4 mm). No grain has fluidised yet at 8 s (critical_head is not reached; printed).
+  // cells as the seepage i = n (w - v) / k next to the pile. exit_gradient_error covers the
+  // intact stage, before the quick condition. For this 0.25 m thick pile a Laplace solve gives
+  // 0.863 of Harr's thin-pile gradient (verification.md I), so the expected error is -0.137;
+  // the measured -0.191 (2026-12-02) is 6 % below it, with 0.6-0.7 of Harr's in the first
+  // 2.4 s. A regression guard, not a verification: within 0.1 of -0.137 (the pressure-based
+  // measure it replaced gave -0.8 on 0.25 m cells). The quick condition (the seepage exit
+  // gradient reaching i_c) occurs once dH
+  // has passed 2 m and before the end; its head is printed beside Harr's 2.955 m and the
+  // prism's 2.66 m, not asserted. The bed next to the pile stays put while dH < 2 m
+  // (heave < 0.1 mm) and rises after the quick condition: heave > 1 mm at 8 s. No grain
+  // reaches n_max by 8 s (critical_head_fluidised printed).
   loam_test::TempDir dir("piping_full");
   auto s = loam_test::run_scene("seed000_piping.yaml", dir.path, "--threads 2");
   const auto& v = s["verify"];
@@ -304,14 +309,20 @@ TEST_CASE("seed 000 piping scene: the exit gradient follows Harr's and the bed h
     if (se["head_difference"][k].get<double>() < 2.0)
       heave_intact = std::max(heave_intact, std::fabs(se["heave"][k].get<double>()));
   std::printf(
-      "piping (0.125 m cells, GIMP, 8 s): exit_gradient_error %+.4f (+-0.15), exit gradient "
-      "%.4f against Harr's %.4f at dH = %.3f m; heave %.2e m while dH < 2 m, %.2e m at the end; "
-      "fluidised grains %g, critical head %s; %ld steps, %.0f s wall\n",
-      v["exit_gradient_error"].get<double>(), v["exit_gradient"].get<double>(),
-      se["exit_gradient_harr"].back().get<double>(), v["head_difference"].get<double>(),
-      heave_intact, v["heave"].get<double>(), v["fluidised_points"].get<double>(),
-      v["critical_head"].dump().c_str(), s["steps"].get<long>(), s["wall_seconds"].get<double>());
-  CHECK(std::fabs(v["exit_gradient_error"].get<double>()) <= 0.15);
+      "piping (0.125 m cells, GIMP, 8 s): exit_gradient_error %+.4f (thick pile -0.137 +- "
+      "0.1); critical head "
+      "(quick condition) %s m against Harr's %.4f and the prism's %.4f; exit gradient %.4f "
+      "against Harr's %.4f at dH = %.3f m; heave %.2e m while dH < 2 m, %.2e m at the end; "
+      "fluidised grains %g (critical_head_fluidised %s); %ld steps, %.0f s wall\n",
+      v["exit_gradient_error"].get<double>(), v["critical_head"].dump().c_str(),
+      v["critical_head_harr"].get<double>(), v["critical_head_prism"].get<double>(),
+      v["exit_gradient"].get<double>(), se["exit_gradient_harr"].back().get<double>(),
+      v["head_difference"].get<double>(), heave_intact, v["heave"].get<double>(),
+      v["fluidised_points"].get<double>(), v["critical_head_fluidised"].dump().c_str(),
+      s["steps"].get<long>(), s["wall_seconds"].get<double>());
+  CHECK(std::fabs(v["exit_gradient_error"].get<double>() - (0.863 - 1)) <= 0.1);
+  REQUIRE(v["critical_head"].is_number());
+  CHECK(v["critical_head"].get<double>() > 2.0);
   CHECK(heave_intact < 1e-4);
   CHECK(v["heave"].get<double>() > 1e-3);
   CHECK(std::fabs(s["mass"]["balance"].get<double>()) <= 1e-9 * s["mass"]["final"].get<double>());

@@ -26,10 +26,13 @@
 // - the fluidised points of the bed (a `contact` field of 0) downstream of the pile, and the heave:
 //   the rise of the highest grain of the bed within d/2 downstream of the pile.
 // Metrics: exit_gradient_error (the slope through the origin of the seepage exit gradient
-// against Harr's over the intact samples with ΔH ≥ ΔH_c/4, minus 1), critical_head (ΔH at the
-// first sample with a fluidised grain downstream; NaN if none), critical_head_harr (π d i_c),
-// critical_head_prism, critical_head_error (against Harr), heave and fluidised_points at the
-// end, critical_gradient.
+// against Harr's over the intact samples, ΔH ≥ ΔH_c/4 and before the critical head, minus 1),
+// critical_head (ΔH at the first sample whose seepage exit gradient reaches i_c: the quick
+// condition next to the pile, zero effective stress at the exit, Harr's and Terzaghi's
+// criterion; NaN if never), critical_head_fluidised (ΔH at the first sample with a grain
+// fluidised at n_max downstream; NaN if none), critical_head_harr (π d i_c),
+// critical_head_prism, critical_head_error (critical_head against Harr), heave and
+// fluidised_points at the end, critical_gradient.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -213,7 +216,8 @@ class SheetPileSeepage : public Reference<D> {
     harr_p_.push_back(i_harr);
     fluidised_.push_back(double(fluidised));
     heave_.push_back(strip_top(sim) - heave_base_);
-    if (fluidised > 0 && !std::isfinite(critical_)) critical_ = dH;
+    if (i_seep >= i_c_ && !std::isfinite(critical_)) critical_ = dH;
+    if (fluidised > 0 && !std::isfinite(fluidised_head_)) fluidised_head_ = dH;
   }
 
   std::map<std::string, double> metrics(Simulation<D>& sim) override {
@@ -222,14 +226,17 @@ class SheetPileSeepage : public Reference<D> {
       sample(sim);
     }
     const double harr = M_PI * d_ * i_c_;
-    // Intact samples with a head difference large enough to measure against.
+    // Intact samples (before the quick condition) with a head difference large enough to
+    // measure against.
     double num = 0, den = 0;
     for (size_t k = 0; k < time_.size(); ++k) {
-      if (fluidised_[k] > 0 || !(head_[k] >= harr / 4) || !std::isfinite(exit_[k])) continue;
+      if (fluidised_[k] > 0 || exit_[k] >= i_c_) break;  // the intact stage ended
+      if (!(head_[k] >= harr / 4) || !std::isfinite(exit_[k])) continue;
       num += exit_[k] * harr_[k], den += harr_[k] * harr_[k];
     }
     return {{"exit_gradient_error", den > 0 ? num / den - 1 : std::nan("")},
             {"critical_head", critical_},
+            {"critical_head_fluidised", fluidised_head_},
             {"critical_head_harr", harr},
             {"critical_head_prism", i_c_ * d_ / prism_mean_head()},
             {"critical_head_error", critical_ / harr - 1},
@@ -254,16 +261,16 @@ class SheetPileSeepage : public Reference<D> {
   }
 
   bool save_state(std::vector<double>& s) const override {
-    s = {clock_.next, critical_, double(time_.size())};
+    s = {clock_.next, critical_, fluidised_head_, double(time_.size())};
     for (const auto* v :
          {&time_, &head_, &up_, &down_, &exit_, &harr_, &exit_p_, &harr_p_, &fluidised_, &heave_})
       s.insert(s.end(), v->begin(), v->end());
     return true;
   }
   void restore_state(const std::vector<double>& s) override {
-    clock_.next = s.at(0), critical_ = s.at(1);
-    const long n = long(s.at(2));
-    long k = 3;
+    clock_.next = s.at(0), critical_ = s.at(1), fluidised_head_ = s.at(2);
+    const long n = long(s.at(3));
+    long k = 4;
     for (auto* v :
          {&time_, &head_, &up_, &down_, &exit_, &harr_, &exit_p_, &harr_p_, &fluidised_, &heave_}) {
       v->assign(s.begin() + k, s.begin() + k + n);
@@ -342,7 +349,8 @@ class SheetPileSeepage : public Reference<D> {
   SampleClock clock_;
   double surface_ = 0, gamma_w_ = 0, i_c_ = 0;
   double width_ = 0, depth_ = 0, band_ = 0, heave_base_ = 0;
-  double critical_ = std::nan("");
+  double critical_ = std::nan("");        // ΔH at the quick condition (i >= i_c)
+  double fluidised_head_ = std::nan("");  // ΔH at the first fluidised grain
   int body_ = -1, set_ = -1, pressure_ = -1, contact_ = -1;
   std::vector<double> time_, head_, up_, down_, exit_, harr_, fluidised_, heave_;
   std::vector<double> exit_p_, harr_p_;  // the exit gradient from the pressures, and Harr's
