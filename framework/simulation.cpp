@@ -37,14 +37,14 @@ bool Simulation<D>::advance(double step_dt, bool check) {
   if (!failure.empty()) return false;
   exchange_particles();
   // Check before sorting: the sort must not see non-finite positions.
-  if (check || step % check_every == 0) {
+  const bool checked = check || step % check_every == 0;
+  if (checked) {
     bool ok = true;
     timed("check_particles", [&] { ok = check_particles(failure); });
     if (!ok) return false;
   }
   timed("partition", [&] { maintain_partition(); });
-  if ((check || step % check_every == 0) && keep_last_good)
-    timed("last_good_copy", [&] { save_last_good(); });
+  if (checked && keep_last_good) timed("last_good_copy", [&] { save_last_good(); });
   return true;
 }
 

@@ -176,13 +176,9 @@ class SheetPileSeepage : public Reference<D> {
     // means of pressure and position: a scheme may hold one pressure per cell), measured and
     // Harr's at the same cell centroids.
     std::map<std::array<long, D>, std::array<double, 4>> cells;  // sum x, y, p; count
+    std::array<long, D> c{};
     for (size_t i = 0; i < P.size(); ++i) {
-      if (x[i] < x_pile_ || x[i] > x_pile_ + width_ || y[i] > surface_ || y[i] < surface_ - depth_)
-        continue;
-      std::array<long, D> c{};
-      for (int d = 0; d < D; ++d)
-        c[size_t(d)] = long(std::floor((P.col(P.position, d)[i] - sim.grid.origin[size_t(d)]) *
-                                       sim.grid.inv_cell[size_t(d)]));
+      if (!window_cell(sim, P, i, c)) continue;
       auto& a = cells[c];
       a[0] += x[i], a[1] += y[i], a[2] += p[i], a[3] += 1;
     }
@@ -279,6 +275,18 @@ class SheetPileSeepage : public Reference<D> {
   }
 
  private:
+  /// Whether point i of Q lies in the exit window (x_pile <= x <= x_pile + width,
+  /// y_s - depth <= y <= y_s), and then its grid cell c (the key both exit gradients group by).
+  bool window_cell(const Simulation<D>& sim, const Particles<D>& Q, size_t i,
+                   std::array<long, D>& c) const {
+    const double x = Q.col(Q.position, 0)[i], y = Q.col(Q.position, D - 1)[i];
+    if (x < x_pile_ || x > x_pile_ + width_ || y > surface_ || y < surface_ - depth_) return false;
+    for (int d = 0; d < D; ++d)
+      c[size_t(d)] = long(std::floor((Q.col(Q.position, d)[i] - sim.grid.origin[size_t(d)]) *
+                                     sim.grid.inv_cell[size_t(d)]));
+    return true;
+  }
+
   /// The exit gradient from the seepage, i = n (w_y - v_y) / k, per cell of the exit window
   /// (liquid points P: w_y; the soil's points S: v_y and n), averaged over the cells weighted by
   /// their liquid points; and Harr's -dh/dy for the head difference dH (central difference)
@@ -288,13 +296,9 @@ class SheetPileSeepage : public Reference<D> {
     // Per cell: liquid x, y, w_y, count; solid v_y, n, count.
     std::map<std::array<long, D>, std::array<double, 7>> cells;
     auto visit = [&](const Particles<D>& Q, size_t i, auto&& add) {
-      const double x = Q.col(Q.position, 0)[i], y = Q.col(Q.position, D - 1)[i];
-      if (x < x_pile_ || x > x_pile_ + width_ || y > surface_ || y < surface_ - depth_) return;
       std::array<long, D> c{};
-      for (int d = 0; d < D; ++d)
-        c[size_t(d)] = long(std::floor((Q.col(Q.position, d)[i] - sim.grid.origin[size_t(d)]) *
-                                       sim.grid.inv_cell[size_t(d)]));
-      add(cells[c], x, y);
+      if (window_cell(sim, Q, i, c))
+        add(cells[c], Q.col(Q.position, 0)[i], Q.col(Q.position, D - 1)[i]);
     };
     for (size_t i = 0; i < P.size(); ++i)
       visit(P, i, [&](auto& a, double x, double y) {
