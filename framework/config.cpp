@@ -1,6 +1,8 @@
 #include "config.hpp"
 
 #include <yaml-cpp/yaml.h>
+
+#include <algorithm>
 #include <map>
 
 #include <filesystem>
@@ -11,6 +13,93 @@
 #include "registry.hpp"
 
 namespace loam {
+
+// GCC 12 at -O3 reports a false -Wrestrict in the std::string operator+ inlined in these schema
+// builders (as in schema.cpp).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wrestrict"
+
+/// One entry of `stages:` (docs/stages.md). Its changes act at the stage's start; a key that is
+/// absent leaves that part of the model as the previous stage had it.
+Schema stage_schema() {
+  Schema st;
+  st.text("name", "stage name (summary.json stages[], messages)").required();
+  st.real("duration", "s", "simulated time of the stage").positive();
+  st.choice("until", {"static"},
+            "static: the stage ends once the model is at rest (the largest particle speed below "
+            "static_speed for static_window), or after max_time as not static");
+  st.real("max_time", "s", "with until: static, the time after which the stage ends as not static")
+      .positive();
+  st.real("static_speed", "m/s",
+          "with until: static: the model is at rest while every particle is slower than this "
+          "(it bounds the kinetic energy: E_k <= M v^2 / 2)")
+      .def("1e-5")
+      .positive();
+  st.real("static_window", "s",
+          "with until: static: how long the speeds must stay below static_speed (0: the time a "
+          "P-wave takes to cross the grid's longest side at the stage's start)")
+      .def("0")
+      .min(0);
+  st.choice("if_not_static", {"stop", "continue"},
+            "what follows a stage that did not reach static: stop the run there (its record says "
+            "so; the remaining stages are listed as not run) or go on")
+      .def("stop");
+  st.plugin_list("loads", "load",
+                 "the loads from this stage on, replacing the previous stage's (an empty list "
+                 "removes them all); their time (ramp_time) counts from the stage's start");
+  st.plugin_list("boundaries", "boundary",
+                 "the boundary conditions from this stage on, replacing the previous ones");
+  st.plugin("damping", "damping",
+            "damping from this stage on (`none` switches it off); absent: unchanged");
+  {
+    Schema m;
+    m.text("body", "the body whose material changes").required();
+    m.plugin("material", "material",
+             "its material from this stage on: the keys given replace the body's current ones "
+             "(checked by the material's schema); with another `type:`, the whole material")
+        .required();
+    st.section_list("materials", m,
+                    "material changes at the stage's start (e.g. phi 42 -> 28 deg, or elastic "
+                    "during a gravity stage and Mohr-Coulomb after it)");
+  }
+  st.string_list("activate",
+                 "bodies whose particles join the run at the stage's start (construction: a body "
+                 "with `active: false`, its initial stress from its `stress:`)")
+      .def("[]");
+  st.string_list("deactivate",
+                 "bodies whose particles leave the run at the stage's start (excavation)")
+      .def("[]");
+  st.string_list("reset",
+                 "what is reset at the stage's start: displacement (the reference of the "
+                 "displacement output and of max_displacement becomes the current position), "
+                 "velocity (every phase), plastic_strain (plastic_strain_eq)")
+      .def("[]");
+  {
+    Schema o;
+    o.integer("every_steps", "write a frame every N steps").min(1);
+    o.real("every_time", "s", "write a frame every T seconds of simulated time").positive();
+    st.section("output", o, "frame interval from this stage on (absent: unchanged)");
+  }
+  st.check([](const Params& p, Diagnostics& d) {
+    const bool until = p.has("until");
+    if (until == p.has("duration"))
+      d.error(p.where(), p.path(), "give exactly one of 'duration' or 'until: static'");
+    if (until && !p.has("max_time"))
+      d.error(p.where("until"), p.path("until"),
+              "until: static needs max_time (the time after which the stage counts as not "
+              "static)");
+    if (!until && p.has("max_time"))
+      d.error(p.where("max_time"), p.path("max_time"), "max_time belongs to until: static");
+    const std::vector<std::string> resets{"displacement", "velocity", "plastic_strain"};
+    const auto& r = p.strings("reset");
+    for (size_t i = 0; i < r.size(); ++i)
+      if (std::find(resets.begin(), resets.end(), r[i]) == resets.end())
+        d.error(p.where("reset", i), p.path("reset") + "." + std::to_string(i),
+                "unknown reset '" + r[i] + "'" + suggest(r[i], resets, "valid values are"));
+  });
+  return st;
+}
+#pragma GCC diagnostic pop
 
 Schema config_schema() {
   const Registry& reg = Registry::instance();
@@ -47,6 +136,10 @@ Schema config_schema() {
              "particles from a source)");
     b.integer("particles_per_cell", "particles per cell along each axis").def("2").min(1).max(10);
     b.plugin("material", "material", "constitutive model of the body").required();
+    b.boolean("active",
+              "false: the body's particles are generated but join the run only when a stage "
+              "activates it (construction)")
+        .def("true");
     b.plugin("velocity", "field", "initial velocity (a list is a constant)").components(kDimension);
     b.plugin("stress", "field", "initial Cauchy stress, Voigt xx yy zz xy yz xz (tension positive)")
         .components(-100);  // resolved to the stress component count below
@@ -79,7 +172,8 @@ Schema config_schema() {
   s.plugin("damping", "damping", "numerical damping (e.g. to reach a static state)");
   {
     Schema t;
-    t.real("end", "s", "simulated end time").required().positive();
+    t.real("end", "s", "simulated end time (a run with `stages:` gives each stage's time instead)")
+        .positive();
     t.real("cfl", "-", "Courant number: dt = cfl * cell / (wave speed + particle speed)")
         .def("0.5")
         .above(0)
@@ -98,7 +192,7 @@ Schema config_schema() {
         .def("1e-6")
         .above(0)
         .below(1);
-    s.section("time", t, "time integration").required();
+    s.section("time", t, "time integration (with stages: without `end`)");
   }
   {
     Schema o;
@@ -137,6 +231,20 @@ Schema config_schema() {
     s.section_list("probes", p, "time series at a particle or a node, written as CSV");
   }
   s.plugin("verify", "reference", "analytic reference; its error metrics go to summary.json");
+  s.section_list("stages", stage_schema(),
+                 "a staged analysis (docs/stages.md): the run goes through these stages in order, "
+                 "each applying its changes at its start and ending after its duration or once "
+                 "static; without it the run is one stage of time.end");
+  s.check([](const Params& p, Diagnostics& d) {
+    const bool staged = !p.list("stages").empty();
+    const Params& t = p.section("time");
+    if (staged && t.has("end"))
+      d.error(t.where("end"), t.path("end"),
+              "a run with stages takes its time from them (each stage's duration or max_time): "
+              "remove time.end");
+    if (!staged && !t.present("end"))
+      d.error(t.where(), t.path(), "missing required key 'end' (simulated end time, s)");
+  });
   {
     Schema n;
     n.integer("sort_every", "sort particles by cell every N steps (locality, thread partition)")
@@ -271,6 +379,46 @@ bool apply_override(YAML::Node root, const std::string& arg, const std::string& 
   return true;
 }
 
+/// stages[].materials[].material gives only what changes: its keys go over the body's material
+/// (of the same type) here, so that the material's own schema checks the whole of it. The keys
+/// keep their places in the file (the stage's where given, the body's otherwise).
+void merge_stage_materials(YAML::Node root) {
+  if (!root["stages"] || !root["stages"].IsSequence() || !root["bodies"] ||
+      !root["bodies"].IsSequence())
+    return;
+  for (size_t s = 0; s < root["stages"].size(); ++s) {
+    YAML::Node changes = root["stages"][s].IsMap() ? root["stages"][s]["materials"] : YAML::Node();
+    if (!changes || !changes.IsSequence()) continue;
+    for (size_t c = 0; c < changes.size(); ++c) {
+      YAML::Node change = changes[c];
+      if (!change.IsMap() || !change["body"] || !change["body"].IsScalar() || !change["material"] ||
+          !change["material"].IsMap())
+        continue;
+      YAML::Node base;
+      for (size_t b = 0; b < root["bodies"].size(); ++b) {
+        YAML::Node body = root["bodies"][b];
+        if (body.IsMap() && body["name"] && body["name"].IsScalar() &&
+            body["name"].Scalar() == change["body"].Scalar())
+          base = body["material"];
+      }
+      if (!base) continue;  // an unknown body: reported when the model is built
+      YAML::Node given = change["material"];
+      const std::string base_type = base.IsScalar() ? base.Scalar()
+                                    : base.IsMap() && base["type"] && base["type"].IsScalar()
+                                        ? base["type"].Scalar()
+                                        : "";
+      if (given["type"] && given["type"].IsScalar() && given["type"].Scalar() != base_type)
+        continue;  // another model: the whole material is given
+      YAML::Node merged(YAML::NodeType::Map);
+      if (base.IsScalar()) merged["type"] = base;
+      if (base.IsMap())
+        for (auto it = base.begin(); it != base.end(); ++it) merged[it->first] = it->second;
+      for (auto it = given.begin(); it != given.end(); ++it) merged[it->first] = it->second;
+      change["material"] = merged;
+    }
+  }
+}
+
 int detect_dimension(const YAML::Node& root) {
   YAML::Node e =
       root.IsMap() && root["grid"] && root["grid"].IsMap() ? root["grid"]["extent"] : YAML::Node();
@@ -331,6 +479,7 @@ LoadedConfig validate_tree(YAML::Node root, const std::string& file,
         location_of(e, "grid.extent", ctx, Location{file, 1, 1}), "grid.extent",
         "the grid needs 1, 2 or 3 components (one per dimension), got " + std::to_string(e.size()));
   }
+  merge_stage_materials(root);
   Schema schema = config_schema();
   // Stress fields have 3 + D(D-1)/2 components (Voigt, with the out-of-plane normal stress).
   for (auto& p : schema.params)

@@ -35,12 +35,12 @@ struct Increment {
 };
 
 /// The loading stages of a path: `count` increments of the same kind each.
-struct Stage {
+struct LoadingStage {
   Increment inc;
   int count = 0;
 };
 
-std::vector<Stage> stages_of(const ElementTest& t) {
+std::vector<LoadingStage> stages_of(const ElementTest& t) {
   const double dt = t.duration / t.increments;
   const double rate = t.strain / t.increments / dt;  // strain per increment / dt
   const double s0 = -t.confining;
@@ -63,7 +63,7 @@ std::vector<Stage> stages_of(const ElementTest& t) {
   } else {
     throw std::invalid_argument("unknown element-test path '" + t.path + "'");
   }
-  std::vector<Stage> st{{inc, t.increments}};
+  std::vector<LoadingStage> st{{inc, t.increments}};
   const int n_unload = int(std::lround(t.unload_strain / t.strain * t.increments));
   if (n_unload > 0 && (t.path == "oedometer" || t.path == "isotropic")) {
     Increment back = inc;
@@ -347,7 +347,7 @@ ElementTestResult run_element_test(const Params& material, const ElementTest& te
   const double dt = test.duration / test.increments;
   const double scale = std::max(test.confining, 1.0);
   int step = 0;
-  for (const Stage& stage : stages_of(test)) {
+  for (const LoadingStage& stage : stages_of(test)) {
     std::vector<double> guess(stage.inc.controlled.size(), 0.0);
     for (int i = 0; i < stage.count; ++i) {
       Mat3 L{};

@@ -52,6 +52,14 @@ bool Params::has(const std::string& k) const {
   auto it = values_.find(k);
   return it != values_.end() && !std::holds_alternative<std::monostate>(it->second.value);
 }
+bool Params::given(const std::string& k) const {
+  auto it = values_.find(k);
+  return has(k) && !it->second.defaulted;
+}
+bool Params::present(const std::string& k) const {
+  auto it = values_.find(k);
+  return it != values_.end() && !it->second.defaulted;
+}
 Location Params::where(const std::string& k) const {
   auto it = values_.find(k);
   return it == values_.end() ? where_ : it->second.where;

@@ -165,6 +165,10 @@ class Params {
   const std::vector<Params>& list(const std::string& key) const;
   /// True when the key was given or has a default.
   bool has(const std::string& key) const;
+  /// True when the key was given (not defaulted): e.g. an empty list given to replace another.
+  bool given(const std::string& key) const;
+  /// True when the key is in the file, even with a value that failed validation.
+  bool present(const std::string& key) const;
 
   /// Plugin type name (for a Plugin map), empty otherwise.
   const std::string& type() const { return type_; }

@@ -4,6 +4,7 @@
 // needs"). Hot loops take raw column pointers once per pass.
 #include <omp.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <stdexcept>
@@ -129,6 +130,23 @@ class Particles {
     compact(material);
     kept = compact(body);
     n_ = kept;
+  }
+
+  /// Append the particles of `src` (a set's inactive body, kept aside): fields are matched by
+  /// name; a field `src` does not hold gets its initial value.
+  void append(const Particles& src) {
+    const size_t n0 = n_;
+    resize(n0 + src.n_);
+    for (auto& f : fields_) {
+      const int h = src.find(f.info.name);
+      if (!f.allocated || !src.has(h)) continue;
+      for (size_t c = 0; c < f.data.size(); ++c)
+        std::copy(src.fields_[size_t(h)].data[c].begin(), src.fields_[size_t(h)].data[c].end(),
+                  f.data[c].begin() + long(n0));
+    }
+    std::copy(src.id.begin(), src.id.end(), id.begin() + long(n0));
+    std::copy(src.material.begin(), src.material.end(), material.begin() + long(n0));
+    std::copy(src.body.begin(), src.body.end(), body.begin() + long(n0));
   }
 
   /// Copy every field into `dst` (the last-good snapshot): the columns in parallel once dst has

@@ -104,6 +104,10 @@ class Run {
     double next_frame_time = 0, dt_first = 0, dt_min = 1e300, dt_max = 0;
     long frame_step = 0, history_step = 0;
     Energies e0;
+    // The running stage: its index, where it began, and for until: static since when every
+    // particle has been slower than static_speed (-1: not now) and the window it needs.
+    long stage = 0, stage_step0 = 0;
+    double stage_start = 0, static_since = -1, static_window = 0;
   };
   LoopState ls_;
   // Checkpoints (output.checkpoint; runner.cpp).
@@ -123,8 +127,14 @@ class Run {
     std::vector<std::pair<std::string, double>> scalars;
     std::vector<double> momentum;
     std::string writer;
+    std::string stages;  // the records of the stages completed (JSON)
     std::vector<std::pair<std::string, std::vector<double>>> plugins;
   };
+  nlohmann::json stage_records_ = nlohmann::json::array();
+  /// The record of the running stage as it ends ("static", "not_static", "done", ...).
+  nlohmann::json stage_record(const std::string& status);
+  /// The frame interval of stage k: the last stage up to k that sets one, or output:.
+  void frame_interval(int k, long& every_steps, double& every_time) const;
   CheckpointImage good_image_;
   template <class F>
   void for_each_checkpoint_scalar(F&& f);

@@ -55,6 +55,8 @@ void Run<D>::check_outputs(Diagnostics& diag) {
       else if (names[i] != "position")
         frame_fields_.push_back(p.find(names[i]));  // one layout: valid in every set
     }
+  // A staged run reports each stage's largest displacement (since the last reset).
+  if (!cfg_.params.list("stages").empty()) need_disp = true;
   for (const auto& pr : cfg_.params.list("probes")) {
     Probe<D> probe;
     probe.name = pr.text("name");

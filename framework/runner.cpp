@@ -66,6 +66,14 @@ void write_series_csv(const std::filesystem::path& file,
   write_file_atomically(file.string(), out.str());
 }
 
+nlohmann::json energy_json(const Energies& e) {
+  return nlohmann::json{
+      {"kinetic", e.kinetic},
+      {"strain", std::isnan(e.strain) ? nlohmann::json() : nlohmann::json(e.strain)},
+      {"gravity", e.gravity},
+      {"momentum", e.momentum}};
+}
+
 }  // namespace
 
 namespace detail {
@@ -170,6 +178,13 @@ void Run<D>::for_each_checkpoint_scalar(F&& f) {
   f("run.e0.kinetic", ls_.e0.kinetic);
   f("run.e0.strain", ls_.e0.strain);
   f("run.e0.gravity", ls_.e0.gravity);
+  f("run.stage", ls_.stage);
+  f("run.stage_step0", ls_.stage_step0);
+  f("run.stage_start", ls_.stage_start);
+  f("run.static_since", ls_.static_since);
+  f("run.static_window", ls_.static_window);
+  f("sim.stage", sim.stage);
+  f("sim.loads_start", sim.loads_start);
 }
 
 template <int D>
@@ -180,6 +195,7 @@ typename Run<D>::CheckpointImage Run<D>::checkpoint_image() {
       [&](const char* name, auto& v) { image.scalars.emplace_back(name, double(v)); });
   image.momentum = ls_.e0.momentum;
   image.writer = writer_->state();
+  image.stages = stage_records_.dump();
   const Simulation<D>& sim = *sim_;
   std::vector<double> state;
   if (sim.reference && sim.reference->save_state(state))
@@ -235,6 +251,7 @@ fs::path Run<D>::write_checkpoint(const CheckpointImage& image) {
     w.doubles(pre + "partition", part);
   }
   w.text("run.writer", image.writer);
+  w.text("run.stages", image.stages);
   for (const auto& [k, v] : image.plugins) w.doubles(k, v);
   w.close();
   checkpoints_.push_back(file);
@@ -304,6 +321,9 @@ void Run<D>::restore_checkpoint() {
     sim.sources[i]->restore_state(r.doubles("plugin.source." + std::to_string(i)));
   // The writer's frame list comes back once the writer is open (loop()).
   resume_writer_state_ = r.text("run.writer");
+  stage_records_ = nlohmann::json::parse(r.text("run.stages"));
+  // The plugins of the stages begun so far (their particle changes are in the checkpoint).
+  for (int k = 0; k <= sim.stage; ++k) sim.swap_stage_plugins(k);
   // The checkpoints of the run so far, and none from beyond this one (that future is redone).
   for (const auto& file : checkpoint_files(dir_)) {
     if (checkpoint_step(file) > sim.step) {
@@ -393,17 +413,62 @@ nlohmann::json Run<D>::base_summary() const {
 }
 
 template <int D>
+void Run<D>::frame_interval(int k, long& every_steps, double& every_time) const {
+  const Params& out = cfg_.params.section("output");
+  every_steps = out.has("every_steps") ? long(out.integer("every_steps")) : 0;
+  every_time = out.has("every_time") ? out.real("every_time") : 0;
+  if (!every_steps && every_time <= 0) every_time = sim_->end_time / 20;
+  for (int j = 0; j <= k && j < int(sim_->stages.size()); ++j)
+    if (sim_->stages[size_t(j)].sets_output) {
+      every_steps = sim_->stages[size_t(j)].every_steps;
+      every_time = sim_->stages[size_t(j)].every_time;
+    }
+}
+
+template <int D>
+nlohmann::json Run<D>::stage_record(const std::string& status) {
+  Simulation<D>& sim = *sim_;
+  const Stage<D>& st = sim.stages[size_t(ls_.stage)];
+  nlohmann::json r;
+  r["name"] = st.name;
+  r["status"] = status;
+  r["start_time"] = ls_.stage_start;
+  r["end_time"] = sim.time;
+  r["steps"] = sim.step - ls_.stage_step0;
+  if (st.until_static) {
+    r["static"] = status == "static";
+    r["static_window"] = ls_.static_window;
+  }
+  r["max_speed"] = sim.max_speed;
+  // The largest displacement since the last reset (the output's displacement reference).
+  double u2 = 0;
+  for (const auto& set : sim.sets) {
+    const Particles<D>& P = set.particles;
+    for (size_t i = 0; i < P.size(); ++i) {
+      double a = 0;
+      for (int d = 0; d < D; ++d)
+        a += std::pow(P.col(P.position, d)[i] - P.col(initial_position_, d)[i], 2);
+      u2 = std::max(u2, a);
+    }
+  }
+  r["max_displacement"] = std::sqrt(u2);
+  r["energy"] = energy_json(sim.energies());
+  if (sim.reference) {
+    nlohmann::json v = nlohmann::json::object();
+    for (const auto& [key, x] : sim.reference->metrics(sim)) v[key] = x;
+    r["verify"] = v;
+  }
+  return r;
+}
+
+template <int D>
 RunResult Run<D>::loop() {
   RunResult res;
   InterruptGuard guard;  // SIGINT, SIGTERM: stop after the current step; SIGXFSZ ignored
   Simulation<D>& sim = *sim_;
   const Params& out = cfg_.params.section("output");
-  const long every_steps = out.has("every_steps") ? long(out.integer("every_steps")) : 0;
-  double every_time = out.has("every_time") ? out.real("every_time") : 0;
-  if (!every_steps && every_time <= 0) every_time = sim.end_time / 20;
   const long history_every = long(out.integer("history_every"));
   const bool resuming = !resume_file_.empty();
-  if (!resuming) ls_.next_frame_time = every_time;
   const bool files = opt_.write_output;
   // A file that cannot be written (WriteError, a failed rename) stops the run with exit 4.
   std::string write_error;
@@ -422,6 +487,10 @@ RunResult Run<D>::loop() {
   } else {
     ls_.e0 = sim.energies();
   }
+  long every_steps = 0;
+  double every_time = 0;
+  frame_interval(int(ls_.stage), every_steps, every_time);
+  if (!resuming) ls_.next_frame_time = every_time;
   if (files)
     guarded([&] {
       open_outputs(resuming ? sim.step : -1);
@@ -437,89 +506,150 @@ RunResult Run<D>::loop() {
   std::string failure;
   auto t0 = Clock::now(), last_report = t0;
   long steps_at_report = 0;
-  const double t_end = sim.end_time;
   const double min_dt_ratio = cfg_.params.section("time").real("min_dt_ratio");
   int interrupted = 0;  // the signal that stopped the run (InterruptGuard)
-  // The state at t = 0 (or the checkpoint) passed the checks. With checkpoints, the run's own
-  // state is kept beside the particles' (good_image_), for a checkpoint of the last good state.
   const bool keep_good_image = files && sim.keep_last_good && checkpointing();
-  if (sim.keep_last_good) sim.save_last_good();
-  if (keep_good_image) good_image_ = checkpoint_image();
-  while (write_error.empty() && sim.time < t_end * (1 - 1e-12) &&
-         (opt_.max_steps < 0 || sim.step < opt_.max_steps)) {
-    double dt = sim.stable_dt();
-    if (ls_.dt_first == 0) ls_.dt_first = dt;
-    if (dt < min_dt_ratio * ls_.dt_first) {
-      failure = "the stable time step collapsed to " + format_number(dt) + " s, below " +
-                "time.min_dt_ratio = " + format_number(min_dt_ratio) + " of the first step's " +
-                format_number(ls_.dt_first) + " s (largest particle speed " +
-                format_number(sim.max_speed) +
-                " m/s): a wave or particle speed exploded; remedies: scheme.update: musl, a "
-                "smaller time.cfl, a smooth shape function (gimp, bspline2, cpdi)";
-      break;
+  const int num_stages = int(sim.stages.size());
+  bool budget = false;           // --max-steps reached
+  std::string stopped_by_stage;  // a stage that did not reach static (if_not_static: stop)
+  bool within_stage = resuming;  // resumed within stage ls_.stage: it has begun already
+  for (int k = resuming ? int(ls_.stage) : 0; k < num_stages; ++k) {
+    Stage<D>& stage = sim.stages[size_t(k)];
+    if (!within_stage) {
+      sim.begin_stage(k);
+      ls_.stage = k;
+      ls_.stage_start = sim.time;
+      ls_.stage_step0 = sim.step;
+      ls_.static_since = -1;
+      // The default window: the time a P-wave takes to cross the grid's longest side.
+      double longest = 0;
+      for (int d = 0; d < D; ++d)
+        longest =
+            std::max(longest, sim.grid.upper_corner()[size_t(d)] - sim.grid.origin[size_t(d)]);
+      ls_.static_window = stage.static_window > 0 ? stage.static_window
+                                                  : longest / std::max(sim.wave_speed(), 1e-300);
+      if (stage.sets_output) {
+        frame_interval(k, every_steps, every_time);
+        ls_.next_frame_time = sim.time + every_time;
+      }
     }
-    if (sim.time + dt > t_end) dt = t_end - sim.time;
-    ls_.dt_min = std::min(ls_.dt_min, dt);
-    ls_.dt_max = std::max(ls_.dt_max, dt);
-    // Whether the step ends at a frame or the end (the particles are then always checked).
-    const long next_step = sim.step + 1;
-    const double next_time = sim.time + dt;
-    const bool frame_due =
-        files && ((every_steps && next_step % every_steps == 0) ||
-                  (every_time > 0 && next_time >= ls_.next_frame_time * (1 - 1e-9)));
-    const bool last = next_time >= t_end * (1 - 1e-12) || next_step == opt_.max_steps;
-    // A checkpoint is written only of a state that passed the check.
-    const bool checkpoint_due =
-        files && !last &&
-        ((checkpoint_every_ > 0 && next_step % checkpoint_every_ == 0) ||
-         (checkpoint_wall_ > 0 &&
-          std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >=
-              checkpoint_wall_));
-    if (!sim.advance(dt, frame_due || last || checkpoint_due)) {
-      failure = sim.failure;
-      break;
+    // The state at the stage's start (or the checkpoint) passed the checks. With checkpoints,
+    // the run's own state is kept beside the particles' (good_image_), for a checkpoint of the
+    // last good state.
+    if (sim.keep_last_good) sim.save_last_good();
+    if (keep_good_image) good_image_ = checkpoint_image();
+    const double t_end = ls_.stage_start + stage.duration;
+    bool reached_static = false;
+    while (write_error.empty() && sim.time < t_end * (1 - 1e-12) &&
+           (opt_.max_steps < 0 || sim.step < opt_.max_steps)) {
+      double dt = sim.stable_dt();
+      if (ls_.dt_first == 0) ls_.dt_first = dt;
+      if (dt < min_dt_ratio * ls_.dt_first) {
+        failure = "the stable time step collapsed to " + format_number(dt) + " s, below " +
+                  "time.min_dt_ratio = " + format_number(min_dt_ratio) + " of the first step's " +
+                  format_number(ls_.dt_first) + " s (largest particle speed " +
+                  format_number(sim.max_speed) +
+                  " m/s): a wave or particle speed exploded; remedies: scheme.update: musl, a "
+                  "smaller time.cfl, a smooth shape function (gimp, bspline2, cpdi)";
+        break;
+      }
+      if (sim.time + dt > t_end) dt = t_end - sim.time;
+      ls_.dt_min = std::min(ls_.dt_min, dt);
+      ls_.dt_max = std::max(ls_.dt_max, dt);
+      // Whether the step ends at a frame or the stage's end (the particles are then checked).
+      const long next_step = sim.step + 1;
+      const double next_time = sim.time + dt;
+      const bool frame_due =
+          files && ((every_steps && next_step % every_steps == 0) ||
+                    (every_time > 0 && next_time >= ls_.next_frame_time * (1 - 1e-9)));
+      const bool last_of_stage = next_time >= t_end * (1 - 1e-12);
+      bool last = last_of_stage || next_step == opt_.max_steps;
+      // A checkpoint is written only of a state that passed the check.
+      const bool checkpoint_due =
+          files && !last &&
+          ((checkpoint_every_ > 0 && next_step % checkpoint_every_ == 0) ||
+           (checkpoint_wall_ > 0 &&
+            std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >=
+                checkpoint_wall_));
+      if (!sim.advance(dt, frame_due || last || checkpoint_due)) {
+        failure = sim.failure;
+        break;
+      }
+      if (sim.step >= sim.max_steps && sim.time < sim.end_time * (1 - 1e-12)) {
+        failure = "time.max_steps = " + std::to_string(sim.max_steps) +
+                  " reached before t = " + format_number(sim.end_time) +
+                  " s; the time step fell to " + format_number(dt) + " s (it was " +
+                  format_number(ls_.dt_max) + " s at most)";
+        break;
+      }
+      // until: static, judged on checked steps (a frame ends the stage there).
+      if (stage.until_static && sim.checked_step == sim.step) {
+        if (sim.max_speed > stage.static_speed)
+          ls_.static_since = -1;
+        else if (ls_.static_since < 0)
+          ls_.static_since = sim.time;
+        reached_static =
+            ls_.static_since >= 0 && sim.time - ls_.static_since >= ls_.static_window * (1 - 1e-12);
+        last = last || reached_static;
+      }
+      if (sim.reference) sim.reference->sample(sim);
+      if (files)
+        guarded([&] {
+          sample_probes(last);
+          if (frame_due || last) {
+            write_frame("");
+            ls_.frame_step = sim.step;
+            while (every_time > 0 && ls_.next_frame_time <= sim.time * (1 + 1e-9))
+              ls_.next_frame_time += every_time;
+          }
+          if ((history_every > 0 && sim.step % history_every == 0) ||
+              (history_every == 0 && (frame_due || last))) {
+            write_history();
+            ls_.history_step = sim.step;
+          }
+          if (checkpoint_due && !last) {  // not of a stage's end (static is known after it)
+            write_checkpoint(checkpoint_image());
+            last_checkpoint = Clock::now();
+          }
+          if (keep_good_image && sim.last_good.step == sim.step) good_image_ = checkpoint_image();
+        });
+      if (!write_error.empty()) break;
+      auto now = Clock::now();
+      if (!opt_.quiet && std::chrono::duration<double>(now - last_report).count() > 3.0) {
+        double el = std::chrono::duration<double>(now - t0).count();
+        double sps = double(sim.step - steps_at_report) /
+                     std::chrono::duration<double>(now - last_report).count();
+        double frac = sim.time / sim.end_time;
+        double eta = frac > 0 ? el * (1 - frac) / frac : 0;
+        spdlog::info("{:5.1f}%  t = {:.4g} s  step {}  {:.3g} steps/s  ETA {:.0f} s", 100 * frac,
+                     sim.time, sim.step, sps, eta);
+        last_report = now;
+        steps_at_report = sim.step;
+      }
+      if ((interrupted = InterruptGuard::requested()) != 0) break;
+      if (reached_static) break;
     }
-    if (sim.step >= sim.max_steps && sim.time < t_end * (1 - 1e-12)) {
-      failure = "time.max_steps = " + std::to_string(sim.max_steps) +
-                " reached before t = " + format_number(t_end) + " s; the time step fell to " +
-                format_number(dt) + " s (it was " + format_number(ls_.dt_max) + " s at most)";
-      break;
+    within_stage = false;
+    budget = opt_.max_steps >= 0 && sim.step >= opt_.max_steps && sim.time < t_end * (1 - 1e-12);
+    const bool stopped = !failure.empty() || interrupted || !write_error.empty() || budget;
+    if (!stage.params.path().empty()) {
+      const std::string status = !failure.empty()     ? "unstable"
+                                 : interrupted        ? "interrupted"
+                                 : stopped            ? "stopped"
+                                 : reached_static     ? "static"
+                                 : stage.until_static ? "not_static"
+                                                      : "done";
+      stage_records_.push_back(stage_record(status));
+      if (status == "not_static")
+        spdlog::warn(
+            "stage {} '{}' did not reach static within max_time = {} s (largest "
+            "particle speed {:.3g} m/s > static_speed = {:.3g} m/s){}",
+            k + 1, stage.name, stage.duration, sim.max_speed, stage.static_speed,
+            stage.stop_if_not_static ? ": the run stops here (if_not_static: stop)" : "");
+      if (status == "not_static" && stage.stop_if_not_static && k + 1 < num_stages)
+        stopped_by_stage = stage.name;
     }
-    if (sim.reference) sim.reference->sample(sim);
-    if (files)
-      guarded([&] {
-        sample_probes(last);
-        if (frame_due || last) {
-          write_frame("");
-          ls_.frame_step = sim.step;
-          while (every_time > 0 && ls_.next_frame_time <= sim.time * (1 + 1e-9))
-            ls_.next_frame_time += every_time;
-        }
-        if ((history_every > 0 && sim.step % history_every == 0) ||
-            (history_every == 0 && (frame_due || last))) {
-          write_history();
-          ls_.history_step = sim.step;
-        }
-        if (checkpoint_due) {
-          write_checkpoint(checkpoint_image());
-          last_checkpoint = Clock::now();
-        }
-        if (keep_good_image && sim.last_good.step == sim.step) good_image_ = checkpoint_image();
-      });
-    if (!write_error.empty()) break;
-    auto now = Clock::now();
-    if (!opt_.quiet && std::chrono::duration<double>(now - last_report).count() > 3.0) {
-      double el = std::chrono::duration<double>(now - t0).count();
-      double sps = double(sim.step - steps_at_report) /
-                   std::chrono::duration<double>(now - last_report).count();
-      double frac = sim.time / t_end;
-      double eta = frac > 0 ? el * (1 - frac) / frac : 0;
-      spdlog::info("{:5.1f}%  t = {:.4g} s  step {}  {:.3g} steps/s  ETA {:.0f} s", 100 * frac,
-                   sim.time, sim.step, sps, eta);
-      last_report = now;
-      steps_at_report = sim.step;
-    }
-    if ((interrupted = InterruptGuard::requested()) != 0) break;
+    if (stopped || !stopped_by_stage.empty()) break;
   }
   if (interrupted && files)  // the state after the last complete step, as a regular frame
     guarded([&] {
@@ -543,13 +673,6 @@ RunResult Run<D>::loop() {
   res.summary["frames"] = frames_;
   if (sim.profiling) res.summary["profile_seconds"] = sim.profile;
   Energies e1 = sim.energies();
-  auto energy_json = [](const Energies& e) {
-    return nlohmann::json{
-        {"kinetic", e.kinetic},
-        {"strain", std::isnan(e.strain) ? nlohmann::json() : nlohmann::json(e.strain)},
-        {"gravity", e.gravity},
-        {"momentum", e.momentum}};
-  };
   // Sources and sinks: counts and the mass balance (round-off when nothing is lost).
   const double mass_now = sim.total_mass();
   res.summary["particles_created"] = sim.created;
@@ -571,6 +694,13 @@ RunResult Run<D>::loop() {
     for (const auto& [name, values] : series) v["series"][name] = values;
     res.summary["verify"] = v;
     if (files && !series.empty()) guarded([&] { write_series_csv(dir_ / "verify.csv", series); });
+  }
+  if (!cfg_.params.list("stages").empty()) {
+    nlohmann::json records = stage_records_;
+    for (size_t k = records.size(); k < sim.stages.size(); ++k)
+      records.push_back({{"name", sim.stages[k].name}, {"status", "not_run"}});
+    res.summary["stages"] = records;
+    if (!stopped_by_stage.empty()) res.summary["stopped_after_stage"] = stopped_by_stage;
   }
   if (!failure.empty()) {
     res.exit_code = 3;

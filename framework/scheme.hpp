@@ -48,6 +48,9 @@ class Scheme {
     return std::numeric_limits<double>::infinity();
   }
   virtual void step(Simulation<D>&, double dt) = 0;
+  /// Particle velocity fields besides `velocity` (e.g. the pore water's of a single-point
+  /// two-phase scheme): a stage's `reset: [velocity]` zeroes them too.
+  virtual std::vector<std::string> velocity_fields() const { return {}; }
   /// Phases on the grid: 1, or 2 for a scheme with a pore-water phase (boundary phase 1).
   virtual int phases() const { return 1; }
   /// Add the energies and momentum of what the scheme carries beyond the particles' mass and

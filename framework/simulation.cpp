@@ -13,14 +13,20 @@ template <int D>
 Simulation<D>::~Simulation() = default;
 
 template <int D>
-double Simulation<D>::stable_dt() const {
-  if (fixed_dt > 0) return fixed_dt;
+double Simulation<D>::wave_speed() const {
   double c = 0;
   for (const auto& s : sets)
     for (size_t m = 0; m < materials.size(); ++m) {
       const auto& r = s.partition.material_ranges[m];
       if (r.end > r.begin) c = std::max(c, materials[m]->wave_speed(s.particles, r.begin, r.end));
     }
+  return c;
+}
+
+template <int D>
+double Simulation<D>::stable_dt() const {
+  if (fixed_dt > 0) return fixed_dt;
+  const double c = wave_speed();
   double dt_cfl = cfl * grid.min_cell() / std::max(c + max_speed, 1e-300);
   return std::min(dt_cfl, scheme->stable_dt(*this));
 }
@@ -42,6 +48,7 @@ bool Simulation<D>::advance(double step_dt, bool check) {
     bool ok = true;
     timed("check_particles", [&] { ok = check_particles(failure); });
     if (!ok) return false;
+    checked_step = step;
   }
   timed("partition", [&] { maintain_partition(); });
   if (checked && keep_last_good) timed("last_good_copy", [&] { save_last_good(); });
@@ -189,7 +196,7 @@ void Simulation<D>::prepare_particle_loads() {
       double* f = s.particles.col(external_force, d);
       std::fill(f, f + s.size(), 0.0);
     }
-  for (auto& l : loads) l->apply_to_particles(*this, time);
+  for (auto& l : loads) l->apply_to_particles(*this, time - loads_start);
 }
 
 template <int D>

@@ -27,6 +27,7 @@
 #include "shape_function.hpp"
 #include "sink.hpp"
 #include "source.hpp"
+#include "stage.hpp"
 #include "writer.hpp"
 
 namespace loam {
@@ -66,6 +67,13 @@ class Simulation {
   std::vector<std::unique_ptr<Sink<D>>> sinks;
   std::unique_ptr<Damping<D>> damping;
   std::unique_ptr<Reference<D>> reference;
+  /// The stages of the run (`stages:`; one implicit stage of time.end without it), and the one
+  /// running (-1 before the first has begun). docs/stages.md.
+  std::vector<Stage<D>> stages;
+  int stage = -1;
+  /// When the running loads began (the start of the stage that set them): a load's time, e.g.
+  /// its ramp, counts from here.
+  double loads_start = 0;
   /// The faces the boundary conditions hold (Boundary::holds_face), collected at set-up: schemes
   /// pass every particle move through held_faces.moved.
   HeldFaces<D> held_faces;
@@ -187,7 +195,7 @@ class Simulation {
     for (const auto& b : boundaries) b->add_forces(f);
   }
   void apply_grid_loads(const NodalVector& force) {
-    for (const auto& l : loads) l->apply_to_grid(*this, force, time);
+    for (const auto& l : loads) l->apply_to_grid(*this, force, time - loads_start);
   }
   void apply_damping(const NodeForces& nf) {
     if (damping) damping->apply(*this, nf);
@@ -239,6 +247,16 @@ class Simulation {
   double mass_created = 0, mass_removed = 0, initial_mass = 0;
   double total_mass() const;
 
+  // --------------------------------------------------------- stages (stages.cpp)
+  /// Begin stage k: its plugins replace the running ones (swap_stage_plugins), then bodies are
+  /// activated and deactivated, material states of a new model initialised, and resets done.
+  void begin_stage(int k);
+  /// Only the plugin exchange of stage k (what a run resumed within stage k redoes for the
+  /// stages 0..k, whose particle changes the checkpoint holds already).
+  void swap_stage_plugins(int k);
+  /// Whether a body's particles are in the run (bodies[].active, then stages).
+  bool body_active(int body) const { return active_[size_t(body)] != 0; }
+
   // --------------------------------------------------------- the loop
   /// One explicit step of length dt, as the runner and the tests take it: particle loads, the
   /// shape function's per-step update, the scheme's step, time and step count, the stability
@@ -246,6 +264,9 @@ class Simulation {
   /// of every set. Returns false, with Simulation::failure saying why, if the run cannot go on.
   bool advance(double dt, bool check = false);
   double stable_dt() const;
+  /// The largest P-wave speed of the particles' materials (m/s), as the CFL step uses it.
+  double wave_speed() const;
+  long checked_step = -1;  // the last step whose particles passed the stability check
   /// Zero and refill particle external forces from loads (only if a load uses them).
   void prepare_particle_loads();
   /// Re-sort the particles of every set now.
@@ -285,6 +306,14 @@ class Simulation {
   /// After a step: sinks remove, then sources create (at the new time).
   void exchange_particles();
   void check_sources_and_sinks(Diagnostics& diag);
+  void create_stages(Diagnostics& diag);
+  /// Set up the stages' plugins of one kind, at the point of the build where the running ones
+  /// of that kind are set up (what: "materials", "boundaries", "loads").
+  void setup_stage_plugins(const char* what, Diagnostics& diag);
+  /// Move the particles of bodies with `active: false` out of their sets (into inactive_).
+  void keep_inactive_bodies_aside();
+  std::vector<Particles<D>> inactive_;  // per body: its particles before it is activated
+  std::vector<char> active_;            // per body
   uint32_t next_id_ = 0;
   std::vector<int> body_set_;  // per config body, its set (0 after an error)
   std::vector<std::pair<std::string, std::pair<Vec, Vec>>> selections_;

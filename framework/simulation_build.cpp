@@ -21,7 +21,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   const auto& g = config.vec("gravity");
   for (int d = 0; d < D; ++d) gravity[size_t(d)] = g[size_t(d)];
   const Params& t = config.section("time");
-  end_time = t.real("end");
+  end_time = t.has("end") ? t.real("end") : 0.0;  // with stages: their sum (create_stages)
   cfl = t.real("cfl");
   fixed_dt = t.has("dt") ? t.real("dt") : 0.0;
   max_steps = long(t.integer("max_steps"));
@@ -39,6 +39,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   // From here on, keep checking after an error wherever the rest does not depend on it, so that
   // one run reports every problem at once.
   create_plugins(diag);
+  create_stages(diag);
   create_sets(diag);
   const size_t errors_before = diag.errors().size();
   generate_bodies(diag);
@@ -49,9 +50,12 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   shape->setup(*this, diag);
   scheme->setup(*this, diag);
   for (size_t m = 0; m < materials.size(); ++m) materials[m]->setup(*this, int(m), diag);
+  setup_stage_plugins("materials", diag);
   if (particles_ok) initialize_fields(diag);
   bool particle_loads = false;
   for (auto& l : loads) particle_loads = particle_loads || l->uses_particle_forces();
+  for (auto& st : stages)
+    for (auto& l : st.loads) particle_loads = particle_loads || l->uses_particle_forces();
   if (particle_loads)
     external_force = request_field(
         {"external_force", D, "N", "applied external force", Particles<D>::axis_names()});
@@ -62,12 +66,16 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
       if (r.end > r.begin) materials[m]->initialize(s.particles, r.begin, r.end);
     }
   if (particles_ok) scheme->initial_state(*this);
+  const size_t generated = num_particles();
+  if (particles_ok) keep_inactive_bodies_aside();
   for (auto& b : boundaries) b->setup(*this, diag);
+  setup_stage_plugins("boundaries", diag);
   held_faces = HeldFaces<D>(grid, boundaries);
   held_faces_water = HeldFaces<D>(grid, boundaries, 1);
   model_checked = true;
   if (!particles_ok) return;  // loads and references select particles
   for (auto& l : loads) l->setup(*this, diag);
+  setup_stage_plugins("loads", diag);
   for (auto& p : sources) p->setup(*this, diag);
   for (auto& p : sinks) p->setup(*this, diag);
   if (diag.ok()) check_sources_and_sinks(diag);
@@ -75,7 +83,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   if (!diag.ok()) return;
   // The sources act at t = 0 too (an inlet starts filled); their particles count as created.
   initial_mass = total_mass();
-  next_id_ = uint32_t(num_particles());
+  next_id_ = uint32_t(generated);  // inactive bodies' particles have their ids already
   for (auto& p : sources) p->apply(*this, time);
   for (auto& s : sets)
     if (s.resized) sort(s);

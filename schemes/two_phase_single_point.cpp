@@ -105,6 +105,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         smooth_(p.text("pressure_smoothing") == "cell") {}
 
   int phases() const override { return 2; }
+  std::vector<std::string> velocity_fields() const override { return {"water_velocity"}; }
   std::vector<SetDeclaration> particle_sets() const override {
     return {{"particles", "points of the saturated mixture: the skeleton carrying its pore water"}};
   }
@@ -123,7 +124,6 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     drag_->setup(sim, diag);
     node_.assign(sim.grid.num_nodes * S, 0.0);
     solved_.assign(sim.grid.num_nodes * 2 * D, 0.0);
-    if (sim.damping) mixture_momentum_.assign(sim.grid.num_nodes * D, 0.0);
     dp_.assign(P.size(), 0.0);
     if (smooth_) cell_.assign(sim.grid.num_cells * 2, 0.0);
     if (musl_) remap_.assign(sim.grid.num_nodes * 2 * D, 0.0);
@@ -243,7 +243,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   std::vector<double> node_;
   std::vector<double> solved_;  // per node: v', w' of the coupled solve (2 D values)
   std::vector<double> move_;    // MUSL: per particle, dt v_grid from the re-map pass (D values)
-  std::vector<double> mixture_momentum_;  // per node (D values), only with damping
+  std::vector<double> mixture_momentum_;  // per node (D values), once damping is on
   // Pore-pressure increments of the step and, per grid cell, the volume-weighted sum of the
   // updated pressures and the volume (pressure_smoothing: cell).
   std::vector<double> dp_, cell_;
@@ -392,6 +392,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// would slow steady seepage (where the water force balances the drag, not zero) by (1 - alpha).
   void damp_mixture(Simulation<D>& sim) {
     if (!sim.damping) return;
+    mixture_momentum_.resize(sim.grid.num_nodes * D);  // damping may start with a later stage
     for_each_record(sim, [&](const double* r, size_t i) {
       for (int d = 0; d < D; ++d) mixture_momentum_[i * D + size_t(d)] = r[kV + d] + r[kW + d];
     });

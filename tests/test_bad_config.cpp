@@ -107,7 +107,7 @@ void require_rejected(const Scratch& s, const Outcome& r, const std::vector<std:
 
 const std::string kTopKeys =
     "plugins, grid, shape_function, scheme, gravity, bodies, selections, boundaries, loads, "
-    "sources, sinks, damping, time, output, probes, verify, numerics";
+    "sources, sinks, damping, time, output, probes, verify, stages, numerics";
 
 }  // namespace
 
@@ -168,7 +168,7 @@ time:
                   "missing required key 'material' (constitutive model of the body)"),
        s.error_at(7, 5, "bodies.0.materal",
                   "unknown key 'materal'; did you mean 'material'? valid keys are: name, set, "
-                  "generator, particles_per_cell, material, velocity, stress, initial")});
+                  "generator, particles_per_cell, material, active, velocity, stress, initial")});
 }
 
 TEST_CASE("a string where a real number is expected", "[bad_config]") {
