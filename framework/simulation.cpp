@@ -146,10 +146,7 @@ void Simulation<D>::add_particles(int b, const std::vector<Vec>& x, const Vec& v
   shape->initialize_particles(*this, set, begin, end);
   scheme->initialize_particles(*this, set, begin, end);
   materials[size_t(b)]->initialize(P, begin, end);
-  const int x0 = P.find("initial_position");  // the output's displacement reference
-  if (P.has(x0))
-    for (int d = 0; d < D; ++d)
-      std::copy(P.col(P.position, d) + begin, P.col(P.position, d) + end, P.col(x0, d) + begin);
+  restart_displacement(P, begin, end);
   for (size_t i = begin; i < end; ++i) mass_created += P.col(P.mass)[i];
   created += x.size();
   set.invalidate_index();
@@ -327,10 +324,7 @@ int Simulation<D>::body_param(const Params& p, const std::string& key, Diagnosti
   }
   const int b = body_index(p.text(key));
   if (b < 0) {
-    std::vector<std::string> names;
-    for (const auto& bd : bodies) names.push_back(bd.name);
-    diag.error(p.where(key), p.path(key),
-               "unknown body '" + p.text(key) + "'; bodies are: " + join(names, ", "));
+    unknown_body(diag, p.where(key), p.path(key), p.text(key));
   } else if (need_particles && bodies[size_t(b)].count == 0) {
     diag.error(p.where(key), p.path(key),
                "body '" + p.text(key) + "' has no particles at t = 0 (no generator)");
@@ -341,9 +335,26 @@ int Simulation<D>::body_param(const Params& p, const std::string& key, Diagnosti
 
 template <int D>
 int Simulation<D>::body_index(const std::string& name) const {
-  for (size_t b = 0; b < bodies.size(); ++b)
-    if (bodies[b].name == name) return int(b);
+  const auto& bl = config.list("bodies");
+  for (size_t b = 0; b < bl.size(); ++b)
+    if (bl[b].text("name") == name) return int(b);
   return -1;
+}
+
+template <int D>
+void Simulation<D>::unknown_body(Diagnostics& diag, const Location& where, const std::string& path,
+                                 const std::string& name) const {
+  std::vector<std::string> names;
+  for (const auto& b : config.list("bodies")) names.push_back(b.text("name"));
+  diag.error(where, path, "unknown body '" + name + "'; bodies are: " + join(names, ", "));
+}
+
+template <int D>
+void Simulation<D>::restart_displacement(Particles<D>& P, size_t begin, size_t end) const {
+  const int x0 = P.find("initial_position");  // the output's displacement reference
+  if (!P.has(x0)) return;
+  for (int d = 0; d < D; ++d)
+    std::copy(P.col(P.position, d) + begin, P.col(P.position, d) + end, P.col(x0, d) + begin);
 }
 
 template <int D>

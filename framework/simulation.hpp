@@ -283,7 +283,14 @@ class Simulation {
   /// if no selection has that name.
   bool selection(const std::string& name, const ParticleSet<D>& set,
                  std::vector<uint32_t>& ids) const;
+  /// Index of the body `name` in the config's `bodies:` (the order of Simulation::bodies), or -1.
   int body_index(const std::string& name) const;
+  /// A located "unknown body 'name'; bodies are: ..." error.
+  void unknown_body(Diagnostics& diag, const Location& where, const std::string& path,
+                    const std::string& name) const;
+  /// Make the current positions of particles [begin, end) of P their displacement reference
+  /// (initial_position, when the output or a reference requested it).
+  void restart_displacement(Particles<D>& P, size_t begin, size_t end) const;
   /// The body a plugin names with `key` (the first body when the key is absent), or -1 after a
   /// located "unknown body" error listing the bodies.
   /// With need_particles (loads, references), a body that starts empty (no generator) is an

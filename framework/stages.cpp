@@ -12,18 +12,12 @@ namespace loam {
 
 namespace {
 
-/// Index of the body `name` in the config's body list, or -1.
-int config_body(const Params& config, const std::string& name) {
-  const auto& bl = config.list("bodies");
-  for (size_t b = 0; b < bl.size(); ++b)
-    if (bl[b].text("name") == name) return int(b);
-  return -1;
-}
-
-std::string body_names(const Params& config) {
-  std::vector<std::string> names;
-  for (const auto& b : config.list("bodies")) names.push_back(b.text("name"));
-  return join(names, ", ");
+/// 1 for the particles of body b (an erase mask).
+template <int D>
+std::vector<uint8_t> of_body(const Particles<D>& P, int b) {
+  std::vector<uint8_t> mask(P.size());
+  for (size_t i = 0; i < P.size(); ++i) mask[i] = P.body[i] == b;
+  return mask;
 }
 
 }  // namespace
@@ -67,10 +61,9 @@ void Simulation<D>::create_stages(Diagnostics& diag) {
     const auto& changes = sp.list("materials");
     for (size_t c = 0; c < changes.size(); ++c) {
       const Params& mc = changes[c];
-      const int b = config_body(config, mc.text("body"));
+      const int b = body_index(mc.text("body"));
       if (b < 0) {
-        diag.error(mc.where("body"), mc.path("body"),
-                   "unknown body '" + mc.text("body") + "'; bodies are: " + body_names(config));
+        unknown_body(diag, mc.where("body"), mc.path("body"), mc.text("body"));
         continue;
       }
       for (size_t k = 0; k < c; ++k)
@@ -96,10 +89,9 @@ void Simulation<D>::create_stages(Diagnostics& diag) {
       const auto& names = sp.strings(key);
       for (size_t i = 0; i < names.size(); ++i) {
         const std::string path = sp.path(key) + "." + std::to_string(i);
-        const int b = config_body(config, names[i]);
+        const int b = body_index(names[i]);
         if (b < 0) {
-          diag.error(sp.where(key, i), path,
-                     "unknown body '" + names[i] + "'; bodies are: " + body_names(config));
+          unknown_body(diag, sp.where(key, i), path, names[i]);
           continue;
         }
         const char now = state[size_t(b)];
@@ -162,8 +154,9 @@ void Simulation<D>::keep_inactive_bodies_aside() {
     any = true;
     ParticleSet<D>& set = sets[size_t(body_set(int(b)))];
     Particles<D>& P = set.particles;
-    std::vector<uint8_t> mine(P.size()), others(P.size());
-    for (size_t i = 0; i < P.size(); ++i) mine[i] = P.body[i] == b, others[i] = !mine[i];
+    const std::vector<uint8_t> mine = of_body(P, int(b));
+    std::vector<uint8_t> others(mine.size());
+    for (size_t i = 0; i < mine.size(); ++i) others[i] = !mine[i];
     inactive_[b] = P;
     inactive_[b].erase(others);
     P.erase(mine);
@@ -191,15 +184,14 @@ void Simulation<D>::begin_stage(int k) {
   Stage<D>& st = stages[size_t(k)];
   if (st.sets_loads) loads_start = time;
   swap_stage_plugins(k);
-  const int x0 = sets[0].particles.find("initial_position");  // the displacement reference
   std::vector<char> resized(sets.size(), 0);
   for (int b : st.deactivate) {
     ParticleSet<D>& set = sets[size_t(body_set(b))];
     Particles<D>& P = set.particles;
-    std::vector<uint8_t> mine(P.size());
+    const std::vector<uint8_t> mine = of_body(P, b);
     size_t n = 0;
     for (size_t i = 0; i < P.size(); ++i)
-      if ((mine[i] = P.body[i] == b)) mass_removed += P.col(P.mass)[i], ++n;
+      if (mine[i]) mass_removed += P.col(P.mass)[i], ++n;
     P.erase(mine);
     removed += n;
     active_[size_t(b)] = 0;
@@ -213,10 +205,7 @@ void Simulation<D>::begin_stage(int k) {
     inactive_[size_t(b)] = Particles<D>();
     for (size_t i = begin; i < P.size(); ++i) mass_created += P.col(P.mass)[i];
     created += P.size() - begin;
-    if (P.has(x0))  // its displacement counts from when it joins the run
-      for (int d = 0; d < D; ++d)
-        std::copy(P.col(P.position, d) + begin, P.col(P.position, d) + P.size(),
-                  P.col(x0, d) + begin);
+    restart_displacement(P, begin, P.size());  // its displacement counts from when it joins
     active_[size_t(b)] = 1;
     resized[size_t(body_set(b))] = 1;
   }
@@ -241,9 +230,7 @@ void Simulation<D>::begin_stage(int k) {
     if (st.reset_velocity)
       for (const auto& f : velocities) zero(f);
     if (st.reset_plastic_strain) zero(plastic_strain_eq_field().name);
-    if (st.reset_displacement && P.has(x0))
-      for (int d = 0; d < D; ++d)
-        std::copy(P.col(P.position, d), P.col(P.position, d) + P.size(), P.col(x0, d));
+    if (st.reset_displacement) restart_displacement(P, 0, P.size());
   }
   if (st.reset_velocity) max_speed = 0;
   if (!st.params.path().empty())
