@@ -26,13 +26,14 @@ Schema stage_schema() {
   st.text("name", "stage name (summary.json stages[], messages)").required();
   st.real("duration", "s", "simulated time of the stage").positive();
   st.choice("until", {"static"},
-            "static: the stage ends once the model is at rest (the largest particle speed below "
-            "static_speed for static_window), or after max_time as not static");
+            "static: the stage ends once the model is at rest (every particle moving slower "
+            "than static_speed for static_window), or after max_time as not static");
   st.real("max_time", "s", "with until: static, the time after which the stage ends as not static")
       .positive();
   st.real("static_speed", "m/s",
-          "with until: static: the model is at rest while every particle is slower than this "
-          "(it bounds the kinetic energy: E_k <= M v^2 / 2)")
+          "with until: static: the model is at rest while every particle moves slower than "
+          "this, |x(n+1) - x(n)| / dt (it bounds the kinetic energy of the motion: E_k <= M v^2 "
+          "/ 2)")
       .def("1e-5")
       .positive();
   st.real("static_window", "s",
@@ -413,7 +414,16 @@ void merge_stage_materials(YAML::Node root) {
       if (base.IsScalar()) merged["type"] = base;
       if (base.IsMap())
         for (auto it = base.begin(); it != base.end(); ++it) merged[it->first] = it->second;
-      for (auto it = given.begin(); it != given.end(); ++it) merged[it->first] = it->second;
+      // A key the body's material has already is found by its text (node keys compare by
+      // identity in yaml-cpp: indexing with the stage's key node would add a second entry, and
+      // the body's value, read first, would win); a new key keeps its node (its place).
+      const YAML::Node& lookup = merged;
+      for (auto it = given.begin(); it != given.end(); ++it) {
+        if (it->first.IsScalar() && lookup[it->first.Scalar()])
+          merged[it->first.Scalar()] = it->second;
+        else
+          merged[it->first] = it->second;
+      }
       change["material"] = merged;
     }
   }

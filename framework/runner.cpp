@@ -440,6 +440,7 @@ nlohmann::json Run<D>::stage_record(const std::string& status) {
     r["static_window"] = ls_.static_window;
   }
   r["max_speed"] = sim.max_speed;
+  if (st.until_static) r["motion_speed"] = sim.motion_speed;
   // The largest displacement since the last reset (the output's displacement reference).
   double u2 = 0;
   for (const auto& set : sim.sets) {
@@ -538,6 +539,7 @@ RunResult Run<D>::loop() {
     // last good state.
     if (sim.keep_last_good) sim.save_last_good();
     if (keep_good_image) good_image_ = checkpoint_image();
+    sim.track_motion = stage.until_static;
     const double t_end = ls_.stage_start + stage.duration;
     bool reached_static = false;
     while (write_error.empty() && sim.time < t_end * (1 - 1e-12) &&
@@ -584,7 +586,7 @@ RunResult Run<D>::loop() {
       }
       // until: static, judged on checked steps (a frame ends the stage there).
       if (stage.until_static && sim.checked_step == sim.step) {
-        if (sim.max_speed > stage.static_speed)
+        if (sim.motion_speed > stage.static_speed)
           ls_.static_since = -1;
         else if (ls_.static_since < 0)
           ls_.static_since = sim.time;
@@ -642,9 +644,9 @@ RunResult Run<D>::loop() {
       stage_records_.push_back(stage_record(status));
       if (status == "not_static")
         spdlog::warn(
-            "stage {} '{}' did not reach static within max_time = {} s (largest "
-            "particle speed {:.3g} m/s > static_speed = {:.3g} m/s){}",
-            k + 1, stage.name, stage.duration, sim.max_speed, stage.static_speed,
+            "stage {} '{}' did not reach static within max_time = {} s (particles still "
+            "moving at up to {:.3g} m/s > static_speed = {:.3g} m/s){}",
+            k + 1, stage.name, stage.duration, sim.motion_speed, stage.static_speed,
             stage.stop_if_not_static ? ": the run stops here (if_not_static: stop)" : "");
       if (status == "not_static" && stage.stop_if_not_static && k + 1 < num_stages)
         stopped_by_stage = stage.name;

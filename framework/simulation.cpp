@@ -37,13 +37,16 @@ bool Simulation<D>::advance(double step_dt, bool check) {
   prepare_particle_loads();
   shape->begin_step(*this);
   if (!failure.empty()) return false;
+  const bool checked = check || (step + 1) % check_every == 0;
+  const bool track = checked && track_motion;
+  if (track) timed("motion", [&] { keep_positions(); });
   scheme->step(*this, dt);
   time += dt;
   ++step;
   if (!failure.empty()) return false;
+  if (track) timed("motion", [&] { motion_speed = largest_move(dt); });
   exchange_particles();
   // Check before sorting: the sort must not see non-finite positions.
-  const bool checked = check || step % check_every == 0;
   if (checked) {
     bool ok = true;
     timed("check_particles", [&] { ok = check_particles(failure); });
@@ -53,6 +56,39 @@ bool Simulation<D>::advance(double step_dt, bool check) {
   timed("partition", [&] { maintain_partition(); });
   if (checked && keep_last_good) timed("last_good_copy", [&] { save_last_good(); });
   return true;
+}
+
+template <int D>
+void Simulation<D>::keep_positions() {
+  motion_x0_.resize(sets.size());
+  for (size_t s = 0; s < sets.size(); ++s) {
+    const Particles<D>& P = sets[s].particles;
+    const size_t n = P.size();
+    std::vector<double>& x0 = motion_x0_[s];
+    x0.resize(n * D);
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long i = 0; i < long(n); ++i)
+      for (int d = 0; d < D; ++d) x0[size_t(i) * D + size_t(d)] = P.col(P.position, d)[i];
+  }
+}
+
+template <int D>
+double Simulation<D>::largest_move(double step_dt) const {
+  double m2 = 0;
+  for (size_t s = 0; s < sets.size(); ++s) {
+    const Particles<D>& P = sets[s].particles;
+    const std::vector<double>& x0 = motion_x0_[s];
+#pragma omp parallel for reduction(max : m2) schedule(static) num_threads(threads)
+    for (long i = 0; i < long(P.size()); ++i) {
+      double a = 0;
+      for (int d = 0; d < D; ++d) {
+        const double dx = P.col(P.position, d)[i] - x0[size_t(i) * D + size_t(d)];
+        a += dx * dx;
+      }
+      m2 = std::max(m2, a);
+    }
+  }
+  return std::sqrt(m2) / step_dt;
 }
 
 template <int D>

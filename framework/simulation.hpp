@@ -267,6 +267,13 @@ class Simulation {
   /// The largest P-wave speed of the particles' materials (m/s), as the CFL step uses it.
   double wave_speed() const;
   long checked_step = -1;  // the last step whose particles passed the stability check
+  /// With track_motion (a stage until: static), each checked step also measures how fast the
+  /// particles actually move: motion_speed = max |x^{n+1} - x^n| / dt over every set. Under FLIP
+  /// the particle velocities carry a component the grid cannot see (more particles than nodes):
+  /// it neither moves the particles nor decays under nodal damping, so the largest particle
+  /// velocity is no measure of rest (docs/stages.md).
+  bool track_motion = false;
+  double motion_speed = 0;
   /// Zero and refill particle external forces from loads (only if a load uses them).
   void prepare_particle_loads();
   /// Re-sort the particles of every set now.
@@ -319,8 +326,11 @@ class Simulation {
   void setup_stage_plugins(const char* what, Diagnostics& diag);
   /// Move the particles of bodies with `active: false` out of their sets (into inactive_).
   void keep_inactive_bodies_aside();
-  std::vector<Particles<D>> inactive_;  // per body: its particles before it is activated
-  std::vector<char> active_;            // per body
+  std::vector<Particles<D>> inactive_;          // per body: its particles before it is activated
+  std::vector<std::vector<double>> motion_x0_;  // per set: positions before a tracked step
+  void keep_positions();
+  double largest_move(double step_dt) const;
+  std::vector<char> active_;  // per body
   uint32_t next_id_ = 0;
   std::vector<int> body_set_;  // per config body, its set (0 after an error)
   std::vector<std::pair<std::string, std::pair<Vec, Vec>>> selections_;

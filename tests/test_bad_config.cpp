@@ -606,3 +606,27 @@ time:
             bad.error_at(7, 46, "bodies.1.material.E", "-1 is out of range (0, inf) Pa") + "\n");
   CHECK_FALSE(fs::exists(bad.out()));
 }
+
+TEST_CASE("a traction on a selection more than one particle layer deep", "[bad_config]") {
+  // Each selected particle carries t A_p: two layers along the normal would double the load
+  // (plugins/loads/traction.cpp). The 2D block has 2 x 2 points per 0.5 m cell: y = 0.875 and
+  // 0.625 m in the top cell, both inside the selection.
+  Scratch s;
+  auto r = s.run(R"(grid: {extent: [2, 2], cell_size: 0.5}
+bodies:
+  - name: block
+    generator: {type: box, min: [0, 0], max: [2, 1]}
+    material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 1000}
+selections:
+  - {name: strip, min: [0.5, 0.5], max: [1.5, 1]}
+loads: [{type: traction, selection: strip, face: y+, traction: [0, -1000]}]
+time: {end: 0.1}
+)");
+  require_rejected(
+      s, r,
+      {s.error_at(8, 37, "loads.0.selection",
+                  "selection 'strip' is more than one particle layer deep along the face normal "
+                  "(particles at y = 0.625 and 0.875 m on one line): a traction loads every "
+                  "selected particle with t A_p, so the load would be multiplied; select only "
+                  "the surface layer")});
+}

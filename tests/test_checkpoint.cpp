@@ -89,6 +89,16 @@ TEST_CASE("a resumed two-phase run is bitwise the uninterrupted one, 1 and 2 thr
         1000, 7000);
 }
 
+TEST_CASE("a run resumed within a stage is bitwise the uninterrupted one, 1 and 2 threads",
+          "[checkpoint][stages]") {
+  // configs/construction_column_1d.yaml: stages settle (steps 1-400), build (the upper body
+  // activated; to step 1710) and excavate (deactivated). The checkpoint of step 1000 lies
+  // within the build stage: the resumed run must neither activate the body again nor lose the
+  // stage's static window, records or plugins.
+  for (const char* threads : {"1", "2"})
+    check_resume("construction_column_1d.yaml", std::string("--threads ") + threads, 500, 1000);
+}
+
 TEST_CASE(
     "a resumed piping run (reservoir, sink, a series reference) is bitwise the same 1 and 2 "
     "threads",

@@ -18,6 +18,9 @@
 // It needs a shape function whose stencil covers the particle domain (not `linear`), otherwise
 // the surface node may carry no mass and the load would be lost.
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
 
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
@@ -33,7 +36,10 @@ class Traction : public Load<D> {
   static Schema schema() {
     Schema s;
     s.text("body", "body whose face is loaded");
-    s.text("selection", "a named selection (`selections:`) to load instead of a body face");
+    s.text("selection",
+           "a named selection (`selections:`) to load instead of a body face: one particle "
+           "layer deep along the face normal (each selected particle carries t A_p; a deeper "
+           "selection is an error)");
     s.text("set", "with `selection`: the particle set it selects from (default: the first)");
     s.choice("face", face_names(), "face (of the body) the traction acts on; sets the loaded area")
         .required();
@@ -88,6 +94,7 @@ class Traction : public Load<D> {
     }
     if (ids_.empty())
       diag.error(params_.where(), params_.path(), "the traction selects no particles");
+    if (params_.has("selection")) check_one_layer(sim, diag);
     area_.resize(ids_.size());
     length_.resize(ids_.size());
     const auto& set = sim.sets[size_t(set_)];
@@ -153,6 +160,37 @@ class Traction : public Load<D> {
   }
 
  private:
+  /// Each selected particle carries t A_p: a selection two particles deep along the face normal
+  /// would carry the traction twice. Particles on one line normal to the face share their
+  /// tangential lattice cell (floor(x / spacing) on every other axis, at set-up).
+  void check_one_layer(const Simulation<D>& sim, Diagnostics& diag) const {
+    const auto& set = sim.sets[size_t(set_)];
+    const auto& P = set.particles;
+    std::map<std::array<long, D>, size_t> line;  // tangential cell -> first particle on it
+    for (uint32_t id : ids_) {
+      const size_t i = set.index_of(id);
+      const auto& spacing = sim.bodies[P.body[i]].spacing;
+      std::array<long, D> key{};
+      for (int d = 0; d < D; ++d)
+        if (d != face_.axis)
+          key[size_t(d)] = long(std::floor(P.col(P.position, d)[i] / spacing[size_t(d)]));
+      const auto [it, first] = line.emplace(key, i);
+      if (first) continue;
+      const char* axes = "xyz";
+      const double a = P.col(P.position, face_.axis)[it->second];
+      const double b = P.col(P.position, face_.axis)[i];
+      diag.error(params_.where("selection"), params_.path("selection"),
+                 "selection '" + params_.text("selection") +
+                     "' is more than one particle layer deep along the face normal (particles "
+                     "at " +
+                     axes[face_.axis] + " = " + format_number(std::min(a, b)) + " and " +
+                     format_number(std::max(a, b)) +
+                     " m on one line): a traction loads every selected particle with t A_p, "
+                     "so the load would be multiplied; select only the surface layer");
+      return;
+    }
+  }
+
   Params params_;
   Face face_;
   double ramp_;
