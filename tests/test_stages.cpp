@@ -170,6 +170,15 @@ fs::path last_frame(const fs::path& out) {
   return last;
 }
 
+/// A probe column at a stage's end time t (the stage's last step is always sampled; the CSV
+/// keeps 12 digits, so the time matches to 1e-9 relative), or NaN when no sample is there.
+double sample_at(std::map<std::string, std::vector<double>>& probe, const std::string& column,
+                 double t) {
+  for (size_t i = 0; i < probe["time"].size(); ++i)
+    if (std::abs(probe["time"][i] - t) < 1e-9 * t) return probe[column][i];
+  return NAN;
+}
+
 }  // namespace
 
 TEST_CASE("the seed-004 gravity stages end at rest with sigma_yy under the crest at rho g depth",
@@ -248,9 +257,7 @@ TEST_CASE("bodies activated and deactivated by stages carry their weight exactly
     const auto& st = s["stages"][size_t(k)];
     CHECK(st["status"] == "static");
     const double t = st["end_time"].get<double>();
-    double sigma = NAN;
-    for (size_t i = 0; i < p["time"].size(); ++i)
-      if (std::abs(p["time"][i] - t) < 1e-9 * t) sigma = p["stress_xx"][i];  // CSV: 12 digits
+    const double sigma = sample_at(p, "stress_xx", t);
     const double exact = -rho_g * (height[k] - 0.05);
     std::printf("%s: base stress %.1f Pa, exact %.1f Pa, error %.3f %% (tolerance 0.5 %%)\n",
                 st["name"].get<std::string>().c_str(), sigma, exact, 100 * (sigma / exact - 1));
@@ -295,14 +302,9 @@ TEST_CASE(
   CHECK(s["stages"][1]["status"] == "static");
   auto p = loam_test::read_csv_columns(d.path / "out" / "probe_tip.csv");
   REQUIRE(p.count("position"));
-  auto at = [&](double t) {
-    for (size_t i = 0; i < p["time"].size(); ++i)
-      if (std::abs(p["time"][i] - t) < 1e-9 * t) return p["position"][i];  // CSV: 12 digits
-    return double(NAN);
-  };
   const double x0 = p["position"][0];
-  const double d1 = x0 - at(s["stages"][0]["end_time"].get<double>());
-  const double d2 = x0 - at(s["stages"][1]["end_time"].get<double>()) - d1;
+  const double d1 = x0 - sample_at(p, "position", s["stages"][0]["end_time"].get<double>());
+  const double d2 = x0 - sample_at(p, "position", s["stages"][1]["end_time"].get<double>()) - d1;
   std::printf(
       "settlement of 1 kPa: %.4e m with E, %.4e m with E/2: ratio %.4f (exact 2, "
       "tolerance 0.5 %%)\n",
@@ -341,10 +343,7 @@ TEST_CASE("the seed-004 staged footing carries its load to static stage by stage
   for (size_t k = 0; k < stages.size(); ++k) {
     const auto& st = stages[k];
     if (st["status"] == "not_run") break;
-    const double t = st["end_time"].get<double>();
-    double y = NAN;
-    for (size_t i = 0; i < p["time"].size(); ++i)
-      if (p["time"][i] <= t * (1 + 1e-9)) y = p["position_y"][i];
+    const double y = sample_at(p, "position_y", st["end_time"].get<double>());
     if (k == 1) y0 = y;  // the load stages count from the gravity state
     if (k < 2) {
       CHECK(st["status"] == "static");
