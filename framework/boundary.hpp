@@ -82,6 +82,9 @@ struct GridUpdate {
 struct GridForces {
   NodalVector mixture{nullptr, 0, 0}, water{nullptr, 0, 0}, porosity{nullptr, 0, 0};
   int count = 1;
+  /// Single-phase schemes: the nodal mass mass.at(n, 0) and momentum of the step, which a
+  /// condition may change together with the force (periodic joins node pairs); else null.
+  NodalVector mass{nullptr, 0, 0}, momentum{nullptr, 0, 0};
 };
 
 template <int D>
@@ -144,6 +147,9 @@ class Boundary {
   /// mechanical condition holds it there (drained, a prescribed pore pressure), or -1: the
   /// water's own points (a double-point scheme's liquid set) may leave through that face.
   virtual int releases_face() const { return -1; }
+  /// The axis along which this condition makes the grid periodic (particles leaving through
+  /// one face of it enter through the other: HeldFaces), or -1 (default).
+  virtual int periodic_axis() const { return -1; }
 };
 
 /// The nodes on one face of the grid ("x-", "x+", "y-", ...), for face-based plugins.
@@ -166,6 +172,7 @@ inline int face_index(const Face& f) {
 template <int D>
 struct HeldFaces {
   std::array<double, D> lower, upper;
+  std::array<double, D> period{};  // > 0 along a periodic axis: the grid's length
   HeldFaces() {
     lower.fill(-std::numeric_limits<double>::infinity());
     upper.fill(std::numeric_limits<double>::infinity());
@@ -173,6 +180,12 @@ struct HeldFaces {
   template <class Boundaries>
   HeldFaces(const Grid<D>& grid, const Boundaries& boundaries, int phase = 0) : HeldFaces() {
     for (const auto& b : boundaries) {
+      const int a = b->periodic_axis();
+      if (a >= 0 && a < D) {
+        lower[size_t(a)] = grid.origin[size_t(a)];
+        upper[size_t(a)] = grid.upper(a);
+        period[size_t(a)] = upper[size_t(a)] - lower[size_t(a)];
+      }
       const int f = b->holds_face(phase);
       if (f < 0 || f >= 2 * D) continue;
       bool released = false;
@@ -194,11 +207,13 @@ struct HeldFaces {
   /// Halfway follows the approach to a held face that the grid gives when it does not
   /// overshoot: the normal velocity t v_1 falls with the distance t h. Only the position
   /// changes, never the velocity, so no momentum is added. Comparisons keep a NaN a NaN, for
-  /// Simulation::check_particles.
+  /// Simulation::check_particles. Along a periodic axis a move beyond a face wraps by the
+  /// grid's length instead (the faces are one: the particle stays in [lower, upper)).
   LOAM_FORCE_INLINE double moved(int d, double x, double dx) const {
     const double to = x + dx, lo = lower[size_t(d)], hi = upper[size_t(d)];
-    if (to <= lo) return lo + 0.5 * (x - lo);
-    if (to >= hi) return hi - 0.5 * (hi - x);
+    if (to <= lo)
+      return period[size_t(d)] ? (to < lo ? to + period[size_t(d)] : to) : lo + 0.5 * (x - lo);
+    if (to >= hi) return period[size_t(d)] ? to - period[size_t(d)] : hi - 0.5 * (hi - x);
     return to;
   }
 };

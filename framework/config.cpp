@@ -100,6 +100,51 @@ Schema stage_schema() {
   });
   return st;
 }
+
+/// `strength_reduction:` (docs/strength_reduction.md): after the stages, the factor of safety by
+/// bisection on the strength reduction factor F, each trial from the last stage's static state.
+Schema strength_reduction_schema() {
+  Schema r;
+  r.vector("factors", "-",
+           "[F_low, F_high]: the bracket the factor of safety is searched in; F_low must leave "
+           "the model static and F_high must not (both are tried first)",
+           2)
+      .positive();
+  r.real("tolerance", "-", "the search ends when the bracket is this narrow (absolute, in F)")
+      .def("0.01")
+      .positive();
+  r.string_list("bodies",
+                "the bodies whose strength is reduced (default: every body whose material has a "
+                "strength: Material::reduced)")
+      .def("[]");
+  r.real("max_time", "s",
+         "simulated time of a trial: a trial not static by then has failed (the slope is still "
+         "moving)")
+      .positive();
+  r.real("static_speed", "m/s",
+         "a trial is static once every particle moves slower than this for static_window "
+         "(|x(n+1) - x(n)| / dt, as for a stage with until: static)")
+      .def("1e-5")
+      .positive();
+  r.real("static_window", "s",
+         "how long the speeds must stay below static_speed (0: the time a P-wave takes to cross "
+         "the grid's longest side)")
+      .def("0")
+      .min(0);
+  r.real("failure_displacement", "m",
+         "a trial fails at once when a particle has moved this far from the static state "
+         "(default: only the time limit decides)")
+      .positive();
+  r.check([](const Params& p, Diagnostics& d) {
+    if (!p.has("factors")) return;
+    const auto& f = p.vec("factors");
+    if (f.size() == 2 && f[1] <= f[0])
+      d.error(p.where("factors"), p.path("factors"),
+              "factors = [" + format_number(f[0]) + ", " + format_number(f[1]) +
+                  "]: F_high must exceed F_low");
+  });
+  return r;
+}
 #pragma GCC diagnostic pop
 
 Schema config_schema() {
@@ -236,6 +281,10 @@ Schema config_schema() {
                  "a staged analysis (docs/stages.md): the run goes through these stages in order, "
                  "each applying its changes at its start and ending after its duration or once "
                  "static; without it the run is one stage of time.end");
+  s.section("strength_reduction", strength_reduction_schema(),
+            "a factor of safety by strength reduction after the last stage "
+            "(docs/strength_reduction.md): c and tan(phi) divided by F, bisection on F, each "
+            "trial from the last stage's static state");
   s.check([](const Params& p, Diagnostics& d) {
     const bool staged = !p.list("stages").empty();
     const Params& t = p.section("time");
@@ -245,6 +294,18 @@ Schema config_schema() {
               "remove time.end");
     if (!staged && !t.present("end"))
       d.error(t.where(), t.path(), "missing required key 'end' (simulated end time, s)");
+    if (p.given("strength_reduction")) {  // its keys are required only when it is given
+      const Params& r = p.section("strength_reduction");
+      if (!staged || !p.list("stages").back().has("until"))
+        d.error(r.where(), r.path(),
+                "strength reduction starts from a static state: the last stage must be `until: "
+                "static` (e.g. the gravity stage)");
+      for (const char* k : {"factors", "max_time"})
+        if (!r.present(k))
+          d.error(r.where(), r.path(k),
+                  std::string("missing required key '") + k + "' (" +
+                      (k[0] == 'f' ? "[F_low, F_high]" : "the time limit of a trial, s") + ")");
+    }
   });
   {
     Schema n;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "particles.hpp"
 #include "shape_function.hpp"
@@ -54,6 +55,10 @@ class Material {
   /// True for a fluid: its stress follows from its current density m/V and its rate alone (no
   /// skeleton), so a scheme may drive its density (the liquid points of two_phase_double_point).
   virtual bool is_fluid() const { return false; }
+  /// Strength reduction (docs/strength_reduction.md): the same model, sharing this one's state
+  /// fields, with its shear strength divided by F (c / F and tan(phi) / F, each model says
+  /// what else). nullptr: the model has no strength to reduce (elastic, fluid).
+  virtual std::unique_ptr<Material<D>> reduced(double /*F*/) const { return nullptr; }
   /// Stored elastic energy of particles [begin, end) (J, per unit thickness in 2D), or NaN if
   /// the model does not define one.
   virtual double strain_energy(const Particles<D>&, size_t, size_t) const {

@@ -68,6 +68,16 @@ class CsvFile {
   std::ofstream out_;
 };
 
+/// until: static on a checked step at `time`: `since` is when the motion last fell to `limit` or
+/// below (-1: it is above now); true once it has stayed there for `window`.
+inline bool at_rest(double time, double speed, double limit, double window, double& since) {
+  if (speed > limit)
+    since = -1;
+  else if (since < 0)
+    since = time;
+  return since >= 0 && time - since >= window * (1 - 1e-12);
+}
+
 template <int D>
 struct Probe {
   std::string name;
@@ -155,6 +165,23 @@ class Run {
   void write_frame(const std::string& label);
   /// summary.json, written under a temporary name and renamed (WriteError on failure).
   void write_summary(const nlohmann::json& summary);
+
+  /// The largest particle displacement from the displacement reference (initial_position).
+  double largest_displacement() const;
+  /// The static window when none is given: the time a P-wave takes to cross the grid's
+  /// longest side.
+  double default_static_window() const;
+
+  // Strength reduction (strength_reduction.cpp).
+  std::vector<int> srf_bodies_;                           // the bodies whose strength is reduced
+  std::vector<std::unique_ptr<Material<D>>> srf_strong_;  // their materials during the trials
+  typename Simulation<D>::GoodState srf_mechanism_;       // the lowest failed trial's end state
+  long srf_steps_ = 0;
+  void check_strength_reduction(Diagnostics& diag);
+  nlohmann::json srf_trial(const typename Simulation<D>::GoodState& start, double F);
+  /// The bisection after the last stage: summary.json's strength_reduction record. The model
+  /// is back in its static state with its full strength afterwards.
+  nlohmann::json strength_reduction();
 
   // The loop and summary.json (runner.cpp).
   nlohmann::json base_summary() const;

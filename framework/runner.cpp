@@ -85,6 +85,7 @@ RunResult Run<D>::execute(bool check_only) {
   int threads = opt_.threads > 0 ? opt_.threads : omp_get_max_threads();
   sim_ = std::make_unique<Simulation<D>>(cfg_.params, threads, diag);
   if (sim_->model_checked) check_outputs(diag);
+  if (sim_->model_checked) check_strength_reduction(diag);
   if (sim_) sim_->profiling = opt_.profile;
   if (!diag.ok()) {
     res.exit_code = 2;
@@ -442,17 +443,7 @@ nlohmann::json Run<D>::stage_record(const std::string& status) {
   r["max_speed"] = sim.max_speed;
   if (st.until_static) r["motion_speed"] = sim.motion_speed;
   // The largest displacement since the last reset (the output's displacement reference).
-  double u2 = 0;
-  for (const auto& set : sim.sets) {
-    const Particles<D>& P = set.particles;
-    for (size_t i = 0; i < P.size(); ++i) {
-      double a = 0;
-      for (int d = 0; d < D; ++d)
-        a += std::pow(P.col(P.position, d)[i] - P.col(initial_position_, d)[i], 2);
-      u2 = std::max(u2, a);
-    }
-  }
-  r["max_displacement"] = std::sqrt(u2);
+  r["max_displacement"] = largest_displacement();
   r["energy"] = energy_json(sim.energies());
   if (sim.reference) {
     nlohmann::json v = nlohmann::json::object();
@@ -522,13 +513,7 @@ RunResult Run<D>::loop() {
       ls_.stage_start = sim.time;
       ls_.stage_step0 = sim.step;
       ls_.static_since = -1;
-      // The default window: the time a P-wave takes to cross the grid's longest side.
-      double longest = 0;
-      for (int d = 0; d < D; ++d)
-        longest =
-            std::max(longest, sim.grid.upper_corner()[size_t(d)] - sim.grid.origin[size_t(d)]);
-      ls_.static_window = stage.static_window > 0 ? stage.static_window
-                                                  : longest / std::max(sim.wave_speed(), 1e-300);
+      ls_.static_window = stage.static_window > 0 ? stage.static_window : default_static_window();
       if (stage.sets_output) {
         frame_interval(k, every_steps, every_time);
         ls_.next_frame_time = sim.time + every_time;
@@ -586,12 +571,8 @@ RunResult Run<D>::loop() {
       }
       // until: static, judged on checked steps (a frame ends the stage there).
       if (stage.until_static && sim.checked_step == sim.step) {
-        if (sim.motion_speed > stage.static_speed)
-          ls_.static_since = -1;
-        else if (ls_.static_since < 0)
-          ls_.static_since = sim.time;
-        reached_static =
-            ls_.static_since >= 0 && sim.time - ls_.static_since >= ls_.static_window * (1 - 1e-12);
+        reached_static = at_rest(sim.time, sim.motion_speed, stage.static_speed, ls_.static_window,
+                                 ls_.static_since);
         last = last || reached_static;
       }
       if (sim.reference) sim.reference->sample(sim);
@@ -653,6 +634,27 @@ RunResult Run<D>::loop() {
     }
     if (stopped || !stopped_by_stage.empty()) break;
   }
+  nlohmann::json srf;  // strength_reduction: from the last stage's static state
+  if (cfg_.params.given("strength_reduction")) {
+    const bool ready = failure.empty() && !interrupted && write_error.empty() && !budget &&
+                       !stage_records_.empty() && int(stage_records_.size()) == num_stages &&
+                       stage_records_.back()["status"] == "static";
+    if (ready) {
+      srf = strength_reduction();
+      if (files && srf_mechanism_.step >= 0)  // the failure mechanism of the lowest failed F
+        guarded([&] {
+          std::swap(sim.last_good, srf_mechanism_);
+          sim.swap_last_good();
+          write_frame("strength_reduction");
+          sim.swap_last_good();
+          std::swap(sim.last_good, srf_mechanism_);
+        });
+      if (srf["status"] == "interrupted") interrupted = InterruptGuard::requested();
+    } else {
+      srf = {{"status", "not_run"},
+             {"reason", "the stages did not end in a static state (see stages[])"}};
+    }
+  }
   if (interrupted && files)  // the state after the last complete step, as a regular frame
     guarded([&] {
       if (ls_.frame_step != sim.step) write_frame("");
@@ -669,7 +671,7 @@ RunResult Run<D>::loop() {
   res.summary["wall_seconds"] = wall;
   res.summary["threads"] = sim.threads;
   res.summary["particle_steps_per_second"] =
-      wall > 0 ? double(sim.num_particles()) * double(sim.step) / wall : 0.0;
+      wall > 0 ? double(sim.num_particles()) * double(sim.step + srf_steps_) / wall : 0.0;
   res.summary["dt_min"] = ls_.dt_min < 1e300 ? ls_.dt_min : 0.0;
   res.summary["dt_max"] = ls_.dt_max;
   res.summary["frames"] = frames_;
@@ -703,6 +705,11 @@ RunResult Run<D>::loop() {
       records.push_back({{"name", sim.stages[k].name}, {"status", "not_run"}});
     res.summary["stages"] = records;
     if (!stopped_by_stage.empty()) res.summary["stopped_after_stage"] = stopped_by_stage;
+  }
+  if (!srf.is_null()) {
+    res.summary["strength_reduction"] = srf;
+    for (const char* k : {"factor_of_safety", "factor_of_safety_bracket"})
+      if (srf.contains(k)) res.summary[k] = srf[k];
   }
   if (!failure.empty()) {
     res.exit_code = 3;

@@ -11,6 +11,32 @@
 
 namespace loam {
 
+namespace {
+
+/// A face a periodic condition joins to its opposite (Boundary::periodic_axis) must not be held
+/// by another condition of the same list: the particles would both wrap and stop there.
+template <int D>
+void check_periodic_faces(const std::vector<std::unique_ptr<Boundary<D>>>& list,
+                          const std::vector<Params>& params, Diagnostics& diag) {
+  for (size_t i = 0; i < list.size() && i < params.size(); ++i) {
+    const int a = list[i]->periodic_axis();
+    if (a < 0) continue;
+    for (size_t j = 0; j < list.size(); ++j)
+      for (int ph = 0; ph < 2 && j != i; ++ph) {
+        const int f = list[j]->holds_face(ph);
+        if (f == 2 * a || f == 2 * a + 1) {
+          diag.error(params[i].where(), params[i].path(),
+                     "another condition (" + params[j].path() + ") holds face " +
+                         face_names()[size_t(f)] +
+                         ", which this periodic condition joins to its opposite face");
+          ph = 2;
+        }
+      }
+  }
+}
+
+}  // namespace
+
 template <int D>
 Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag) : config(cfg) {
   threads = std::max(1, num_threads);
@@ -70,6 +96,10 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   if (particles_ok) keep_inactive_bodies_aside();
   for (auto& b : boundaries) b->setup(*this, diag);
   setup_stage_plugins("boundaries", diag);
+  check_periodic_faces(boundaries, config.list("boundaries"), diag);
+  for (size_t k = 0; k < stages.size(); ++k)
+    if (stages[k].sets_boundaries)
+      check_periodic_faces(stages[k].boundaries, stages[k].params.list("boundaries"), diag);
   held_faces = HeldFaces<D>(grid, boundaries);
   held_faces_water = HeldFaces<D>(grid, boundaries, 1);
   model_checked = true;

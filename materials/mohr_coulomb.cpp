@@ -58,9 +58,12 @@ class MohrCoulomb : public Material<D> {
       : E_(p.real("E")),
         nu_(p.real("nu")),
         rho_(p.real("density")),
-        surface_(E_, nu_, p.real("c"), p.real("phi"), p.real("psi"),
-                 p.has("tension_cutoff") ? p.real("tension_cutoff")
-                                         : std::numeric_limits<double>::infinity()) {
+        c_(p.real("c")),
+        phi_(p.real("phi")),
+        psi_(p.real("psi")),
+        cutoff_(p.has("tension_cutoff") ? p.real("tension_cutoff")
+                                        : std::numeric_limits<double>::infinity()),
+        surface_(E_, nu_, c_, phi_, psi_, cutoff_) {
     G_ = E_ / (2 * (1 + nu_));
     lambda_ = E_ * nu_ / ((1 + nu_) * (1 - 2 * nu_));
     M_ = lambda_ + 2 * G_;
@@ -75,6 +78,18 @@ class MohrCoulomb : public Material<D> {
 
   double wave_speed(const Particles<D>& P, size_t b, size_t e) const override {
     return p_wave_speed(P, b, e, M_);  // elastic P-wave speed bounds the plastic one
+  }
+
+  /// c / F and tan(phi) / F; psi is kept unless it would exceed the reduced phi (psi <= phi);
+  /// a given tension cutoff is divided by F (the default, the apex c / tan(phi), is unchanged).
+  std::unique_ptr<Material<D>> reduced(double F) const override {
+    auto m = std::make_unique<MohrCoulomb>(*this);
+    m->c_ = c_ / F;
+    m->phi_ = reduced_friction_angle(phi_, F);
+    m->psi_ = std::min(psi_, m->phi_);
+    m->cutoff_ = cutoff_ / F;
+    m->surface_ = MohrCoulombSurface(E_, nu_, m->c_, m->phi_, m->psi_, m->cutoff_);
+    return m;
   }
 
   void update_stress(const MaterialBatch<D>& batch) override {
@@ -97,6 +112,7 @@ class MohrCoulomb : public Material<D> {
 
  private:
   double E_, nu_, rho_, G_ = 0, lambda_ = 0, M_ = 0;
+  double c_, phi_, psi_, cutoff_;  // Pa, degrees, degrees, Pa
   MohrCoulombSurface surface_;
   int eq_ = -1;
 };

@@ -39,6 +39,12 @@
 
 namespace loam {
 
+/// Strength reduction by a factor F (docs/strength_reduction.md): the friction angle (degrees)
+/// whose tangent is tan(phi) / F, as c / F is the reduced cohesion (Dawson et al. 1999).
+inline double reduced_friction_angle(double phi_deg, double F) {
+  return std::atan(std::tan(phi_deg * M_PI / 180.0) / F) * 180.0 / M_PI;
+}
+
 class MohrCoulombSurface {
  public:
   using Vec3 = Eigen::Vector3d;

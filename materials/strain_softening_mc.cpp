@@ -138,6 +138,19 @@ class StrainSofteningMC : public Material<D> {
     return p_wave_speed(P, b, e, M_);  // elastic P-wave speed bounds the plastic one
   }
 
+  /// Peak and residual strength alike: c / F, tan(phi) / F, psi capped by the reduced phi; a
+  /// given tension cutoff divided by F.
+  std::unique_ptr<Material<D>> reduced(double F) const override {
+    auto m = std::make_unique<StrainSofteningMC>(*this);
+    for (int k = 0; k < 2; ++k) {
+      m->c_[k] = c_[k] / F;
+      m->phi_[k] = reduced_friction_angle(phi_[k], F);
+      m->psi_[k] = std::min(psi_[k], m->phi_[k]);
+    }
+    m->cutoff_ = cutoff_ / F;
+    return m;
+  }
+
   /// The yield surface with the parameters at equivalent plastic strain x.
   MohrCoulombSurface surface(double x) const {
     const double t = std::clamp((x - start_) / (end_ - start_), 0.0, 1.0);

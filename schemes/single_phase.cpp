@@ -226,6 +226,8 @@ class SinglePhase : public Scheme<D> {
     sim.apply_grid_loads(node_vector(kForce));
     GridForces forces;
     forces.mixture = node_vector(kForce);
+    forces.mass = node_vector(kMass);
+    forces.momentum = node_vector(kMomentum);
     sim.apply_boundary_forces(forces);
     sim.apply_damping(NodeForces{node_.data(), node_vector(kMomentum), node_vector(kForce),
                                  sim.grid.num_nodes, S});

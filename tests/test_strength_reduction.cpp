@@ -1,0 +1,261 @@
+// Strength reduction (issue 15, docs/strength_reduction.md) and the periodic grid it is tested
+// on. The factor of safety of an infinite cohesionless slope with associated flow is
+// tan(phi) / tan(beta) (docs/strength_reduction.md, Infinite slope); trials restart from the same
+// static state (a trial's record does not depend on the trials before it); a periodic grid keeps
+// a rigid translation across its faces stress-free; bad input gives located errors.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "cli.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// summary.json of a run directory.
+nlohmann::json summary_of(const fs::path& out) {
+  std::ifstream in(out / "summary.json");
+  return nlohmann::json::parse(in);
+}
+
+/// The trial of factor F in a strength_reduction record (null if none).
+nlohmann::json trial_at(const nlohmann::json& srf, double F) {
+  for (const auto& t : srf["trials"])
+    if (t["factor"].get<double>() == F) return t;
+  return nullptr;
+}
+
+/// A small 2D model for the bad-input cases: one Mohr-Coulomb body `soil`, one elastic body
+/// `rock`, then `rest` (from line 11 on), with a shape function.
+std::string model(const std::string& rest, const std::string& shape = "linear") {
+  return "grid: {extent: [1.0, 1.2], cell_size: 0.1}\n"
+         "shape_function: " +
+         shape + "\n" +
+         "gravity: [0, -9.81]\n"
+         "bodies:\n"
+         "  - name: soil\n"
+         "    generator: {type: box, min: [0, 0.5], max: [1, 1]}\n"
+         "    material: {type: mohr_coulomb, E: 1.0e7, nu: 0.3, density: 2000, c: 0, phi: 30, psi: "
+         "0}\n"
+         "  - name: rock\n"
+         "    generator: {type: box, min: [0, 0], max: [1, 0.5]}\n"
+         "    material: {type: linear_elastic, E: 1.0e8, nu: 0.3, density: 2500}\n" +
+         rest;
+}
+
+}  // namespace
+
+TEST_CASE("strength reduction of an infinite cohesionless slope gives tan(phi) / tan(beta)",
+          "[srf]") {
+  loam_test::TempDir d("srf_infinite");
+  const auto s = loam_test::run_scene("infinite_slope_srf.yaml", d.path / "out", "--threads 2");
+  const auto& srf = s["strength_reduction"];
+  INFO(srf.dump(1));
+  REQUIRE(srf["status"] == "converged");
+  // The slope angle from the config's tilted gravity, phi from its material.
+  const auto& g = s["config"]["gravity"];
+  const double beta = std::atan(g[0].get<double>() / -g[1].get<double>());
+  const double phi = s["config"]["bodies"][0]["material"]["phi"].get<double>() * M_PI / 180;
+  const double exact = std::tan(phi) / std::tan(beta);
+  const double fos = s["factor_of_safety"].get<double>();
+  const double lo = s["factor_of_safety_bracket"][0], hi = s["factor_of_safety_bracket"][1];
+  std::printf(
+      "infinite slope, beta = %.4f deg, phi = 30 deg, c = 0, psi = phi: FoS = %.4f (bracket "
+      "[%.4f, %.4f], %zu trials, %.1f s wall) against tan(phi)/tan(beta) = %.4f: %+.2f %% "
+      "(tolerance 5 %%)\n",
+      beta * 180 / M_PI, fos, lo, hi, srf["trials"].size(), srf["wall_seconds"].get<double>(),
+      exact, 100 * (fos / exact - 1));
+  CHECK(std::abs(fos / exact - 1) < 0.05);
+  CHECK(hi - lo <= srf["tolerance"].get<double>() * (1 + 1e-9));
+  CHECK(fos == Approx(0.5 * (lo + hi)));
+  // The bisection is consistent: every factor up to lo was stable, every one from hi failed.
+  for (const auto& t : srf["trials"]) {
+    const double F = t["factor"];
+    if (F <= lo) CHECK(t["status"] == "static");
+    if (F >= hi) CHECK(t["status"] != "static");
+  }
+  // The stages before it ended static, and the mechanism frame of the lowest failed factor was
+  // written with its plastic strain.
+  for (const auto& st : s["stages"]) CHECK(st["status"] == "static");
+  fs::path mechanism;
+  for (const auto& e : fs::directory_iterator(d.path / "out"))
+    if (e.path().filename().string().find("_strength_reduction.h5") != std::string::npos)
+      mechanism = e.path();
+  REQUIRE(!mechanism.empty());
+  const auto eq = loam_test::read_frame_doubles(mechanism, "plastic_strain_eq");
+  double eq_max = 0;
+  for (double v : eq) eq_max = std::max(eq_max, v);
+  std::printf("mechanism frame %s: largest plastic strain %.3g\n", mechanism.filename().c_str(),
+              eq_max);
+  CHECK(eq_max > 1e-3);
+}
+
+TEST_CASE("strength-reduction trials restart from the same static state", "[srf]") {
+  // F = 1.6 is the third trial of both searches, after (1.2, 2.0) in one and (1.4, 1.8) in the
+  // other: its record must be the same to the bit.
+  loam_test::TempDir a("srf_order_a"), b("srf_order_b");
+  const auto sa = loam_test::run_scene("infinite_slope_srf.yaml", a.path / "out",
+                                       "--threads 1 --set strength_reduction.tolerance=0.3");
+  const auto sb =
+      loam_test::run_scene("infinite_slope_srf.yaml", b.path / "out",
+                           "--threads 1 --set strength_reduction.factors=[1.4,1.8] --set "
+                           "strength_reduction.tolerance=0.3");
+  const auto ta = trial_at(sa["strength_reduction"], 1.6),
+             tb = trial_at(sb["strength_reduction"], 1.6);
+  INFO(sa["strength_reduction"].dump(1) << sb["strength_reduction"].dump(1));
+  REQUIRE(!ta.is_null());
+  REQUIRE(!tb.is_null());
+  std::printf(
+      "F = 1.6 after (1.2, 2.0) and after (1.4, 1.8): %s / %s, %ld / %ld steps, largest "
+      "displacement %.17g / %.17g m\n",
+      ta["status"].get<std::string>().c_str(), tb["status"].get<std::string>().c_str(),
+      ta["steps"].get<long>(), tb["steps"].get<long>(), ta["max_displacement"].get<double>(),
+      tb["max_displacement"].get<double>());
+  CHECK(ta["status"] == tb["status"]);
+  CHECK(ta["steps"] == tb["steps"]);
+  CHECK(ta["max_displacement"].get<double>() == tb["max_displacement"].get<double>());
+  CHECK(ta["motion_speed"].get<double>() == tb["motion_speed"].get<double>());
+  // After the search the model is back in its static state: both runs end identical.
+  CHECK(sa["energy_final"] == sb["energy_final"]);
+}
+
+TEST_CASE("a periodic grid carries a rigid translation across its faces without stress",
+          "[srf][periodic][invariance]") {
+  // A 1 m x 0.5 m block filling the periodic width moves at (2, 0.5) m/s for 1 s, no gravity:
+  // every particle crosses the periodic faces twice. Reference: a rigid translation gives no
+  // strain, so the stress stays at round-off, and x = x0 + 2 t (mod 1), y = y0 + 0.5 t.
+  loam_test::TempDir d("periodic_rigid");
+  const std::string yaml =
+      "grid: {extent: [1.0, 1.5], cell_size: 0.1}\n"
+      "shape_function: linear\n"
+      "bodies:\n"
+      "  - name: block\n"
+      "    generator: {type: box, min: [0, 0.2], max: [1, 0.7]}\n"
+      "    velocity: [2, 0.5]\n"
+      "    material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2000}\n"
+      "boundaries:\n"
+      "  - {type: periodic, axis: x}\n"
+      "time: {end: 1.0}\n"
+      "output: {every_time: 1.0, fields: [velocity, stress, displacement]}\n";
+  auto r = loam_test::run_yaml(d.path, yaml, "--threads 2");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  const fs::path last = d.path / "out" / "particles_000001.h5";
+  REQUIRE(fs::exists(last));
+  const auto x = loam_test::read_frame_doubles(last, "position");
+  const auto u = loam_test::read_frame_doubles(last, "displacement");
+  const auto v = loam_test::read_frame_doubles(last, "velocity");
+  const auto s = loam_test::read_frame_doubles(last, "stress");
+  const size_t n = x.size() / 3;
+  REQUIRE(n == 200);
+  double s_max = 0, v_err = 0, x_err = 0;
+  for (double c : s) s_max = std::max(s_max, std::abs(c));
+  const double t = summary_of(d.path / "out")["end_time"];
+  for (size_t i = 0; i < n; ++i) {
+    v_err = std::max({v_err, std::abs(v[3 * i] - 2), std::abs(v[3 * i + 1] - 0.5)});
+    double dx = u[3 * i] - 2 * t;  // the displacement output jumps by the period on a wrap
+    dx -= std::round(dx);
+    x_err = std::max({x_err, std::abs(dx), std::abs(u[3 * i + 1] - 0.5 * t)});
+    CHECK(x[3 * i] >= 0.0);
+    CHECK(x[3 * i] < 1.0);
+  }
+  std::printf(
+      "periodic rigid translation, 1 s at (2, 0.5) m/s: largest |stress| %.3g Pa "
+      "(tolerance 1e-5), velocity error %.3g m/s, position error %.3g m (1e-9)\n",
+      s_max, v_err, x_err);
+  CHECK(s_max < 1e-5);
+  CHECK(v_err < 1e-9);
+  CHECK(x_err < 1e-9);
+}
+
+TEST_CASE("bad strength-reduction and periodic input: located errors, exit 2, no output",
+          "[srf][bad_config]") {
+  loam_test::TempDir d("srf_bad");
+  const std::string stages =
+      "stages:\n"
+      "  - {name: gravity, until: static, max_time: 1}\n";  // line 13
+  auto check = [&](const std::string& yaml, const std::vector<std::string>& lines) {
+    auto r = loam_test::run_yaml(d.path, yaml);
+    INFO(r.output);
+    CHECK(r.exit_code == 2);
+    CHECK_FALSE(fs::exists(d.path / "out"));
+    const std::string f = (d.path / "run.yaml").string();
+    for (const auto& e : lines) {
+      INFO(e);
+      CHECK(r.output.find(f + e) != std::string::npos);
+    }
+  };
+  // The schema: F_high below F_low, a missing max_time, the last stage not until: static.
+  check(model("boundaries: [{type: fixed, face: y-}]\n"
+              "stages:\n"
+              "  - {name: gravity, until: static, max_time: 1}\n"
+              "  - {name: more, duration: 1}\n"
+              "strength_reduction: {factors: [2.0, 1.5]}\n"),  // line 15
+        {":15:21: error: strength_reduction: strength reduction starts from a static state",
+         ":15:31: error: strength_reduction.factors: factors = [2, 1.5]: F_high must exceed "
+         "F_low",
+         ":15:21: error: strength_reduction.max_time: missing required key 'max_time'"});
+  // The bodies: an unknown one, an elastic one.
+  check(model("boundaries: [{type: fixed, face: y-}]\n" + stages +
+              "strength_reduction: {factors: [1, 2], max_time: 1, bodies: [sand, rock]}\n"),
+        {":14:61: error: strength_reduction.bodies.0: unknown body 'sand'; bodies are: soil, rock",
+         ":14:67: error: strength_reduction.bodies.1: body 'rock' has a material without a "
+         "strength to reduce"});
+  // Periodic with a wide stencil, and with a face another condition holds.
+  check(model("boundaries: [{type: fixed, face: y-}, {type: periodic, axis: x}, {type: slip, "
+              "face: x+}]\n" +
+                  stages,
+              "gimp"),
+        {":11:39: error: boundaries.1: a periodic grid needs a stencil of two nodes per axis",
+         ":11:39: error: boundaries.1: another condition (boundaries.2) holds face x+"});
+}
+
+TEST_CASE("the seed-004 slope's factor of safety by strength reduction, beside Bishop's",
+          "[srf][seed004][full]") {
+  // docs/strength_reduction.md, The seed-004 slope against Bishop. Bishop's simplified method
+  // (tools/bishop.py) for the same slope: 2.089. Measured 2026-12-03: 2.324 (bracket [2.319,
+  // 2.330]), +11.3 %. The guard [2.24, 2.42] is a regression band of 4 % around the measured
+  // value (the SRF factor of a coarse model is expected above the limit-equilibrium one), not a
+  // tolerance against Bishop.
+  loam_test::TempDir d("srf_seed004");
+  const auto s = loam_test::run_scene("seed004_slope_srf.yaml", d.path / "out", "--threads 2");
+  const auto& srf = s["strength_reduction"];
+  INFO(srf.dump(1));
+  REQUIRE(srf["status"] == "converged");
+  auto b = loam_test::run_command("/usr/bin/python3 " + std::string(LOAM_SOURCE_DIR) +
+                                  "/tools/bishop.py --json --height 4.5 --angle 26.565 "
+                                  "--gamma 15696 --c 5000 --phi 30 --depth 5");
+  REQUIRE(b.exit_code == 0);
+  const double bishop = nlohmann::json::parse(b.output)["factor_of_safety"];
+  const double fos = s["factor_of_safety"];
+  std::printf(
+      "seed-004 slope: SRF FoS = %.4f (bracket [%.4f, %.4f], %zu trials, %ld trial steps, %.0f "
+      "s wall) against Bishop %.4f: %+.1f %% (regression band 2.24-2.42)\n",
+      fos, s["factor_of_safety_bracket"][0].get<double>(),
+      s["factor_of_safety_bracket"][1].get<double>(), srf["trials"].size(),
+      srf["steps"].get<long>(), s["wall_seconds"].get<double>(), bishop, 100 * (fos / bishop - 1));
+  CHECK(fos > 2.24);
+  CHECK(fos < 2.42);
+  CHECK(fos > bishop);  // a coarse SRF model is not more critical than limit equilibrium
+  // The mechanism: the particle that moved most in the lowest failed trial is on the slope's
+  // face or crest edge (x in [6, 17] m, above the base layer), a slide, not the base.
+  fs::path mechanism;
+  for (const auto& e : fs::directory_iterator(d.path / "out"))
+    if (e.path().filename().string().find("_strength_reduction.h5") != std::string::npos)
+      mechanism = e.path();
+  REQUIRE(!mechanism.empty());
+  const auto x = loam_test::read_frame_doubles(mechanism, "position");
+  const auto u = loam_test::read_frame_doubles(mechanism, "displacement");
+  size_t k = 0;
+  double u_max = 0;
+  for (size_t i = 0; i < x.size() / 3; ++i) {
+    const double a = std::hypot(u[3 * i], u[3 * i + 1]);
+    if (a > u_max) u_max = a, k = i;
+  }
+  std::printf("largest displacement %.3f m at (%.2f, %.2f) m\n", u_max, x[3 * k], x[3 * k + 1]);
+  CHECK(x[3 * k] > 6);
+  CHECK(x[3 * k] < 17);
+  CHECK(x[3 * k + 1] > 5);
+}
