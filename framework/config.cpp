@@ -246,7 +246,10 @@ Schema config_schema() {
     o.real("every_time", "s", "write a frame every T seconds of simulated time").positive();
     o.string_list(
          "fields",
-         "particle fields to write besides position (an unknown name lists the available ones)")
+         "particle fields to write besides position (an unknown name lists the available "
+         "ones); derived when written: displacement (since the last displacement reset) and "
+         "strain_magnitude (sqrt(eps:eps) of the logarithmic strain 1/2 ln(F F^T) since that "
+         "reset; it requests the deformation gradient F)")
         .def("[velocity, stress]");
     o.plugin("writer", "writer", "output format").def(reg.default_of("writer"));
     o.integer("history_every",
@@ -312,7 +315,9 @@ Schema config_schema() {
     n.integer("sort_every", "sort particles by cell every N steps (locality, thread partition)")
         .def("20")
         .min(1);
-    n.real("mass_tolerance", "kg", "nodes with less mass get zero velocity (guards division)")
+    n.real("mass_tolerance", "kg",
+           "nodes with less mass get no acceleration (f / m is unbounded there) but keep their "
+           "points' mean velocity p / m")
         .def("1e-12")
         .positive();
     n.integer("check_every", "check particles for NaN/inf and leaving the grid every N steps")

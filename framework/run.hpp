@@ -107,6 +107,7 @@ class Run {
   CsvFile history_;
   fs::path dir_;
   int displacement_ = -1, initial_position_ = -1;
+  int strain_magnitude_ = -1, reset_F_ = -1;  // the strain_magnitude output and its reference
   long frames_ = 0;
 
   /// What the time loop carries from step to step besides the simulation (checkpointed).
@@ -158,6 +159,8 @@ class Run {
   void check_outputs(Diagnostics& diag);
   std::string prepare_directory();
   void refresh_derived();
+  /// The strain_magnitude output of particle i (hencky_strain_norm since the last reset).
+  double strain_magnitude(const Particles<D>& p, size_t i) const;
   void open_outputs(long resume_step = -1);
   void sample_probes(bool force);
   void write_history();

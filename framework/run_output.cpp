@@ -8,21 +8,40 @@
 #include <fstream>
 
 #include "registry.hpp"
+#include "strain_measure.hpp"
 
 namespace loam {
 namespace detail {
 
 namespace {
 
-/// Output fields that are not stored but derived when written.
+/// Output fields that are not stored but derived when written: the displacement and the
+/// magnitude of the logarithmic strain, both since the last displacement reset.
 bool derived_field(const std::string& name) {
-  return name == "displacement";
+  return name == "displacement" || name == "strain_magnitude";
 }
 
 }  // namespace
 
 template <int D>
 void Run<D>::check_outputs(Diagnostics& diag) {
+  // strain_magnitude needs F and its value at the last reset: requested before the names are
+  // checked, so that deformation_gradient can be written beside it.
+  auto names_strain = [](const std::vector<std::string>& f) {
+    return std::find(f.begin(), f.end(), "strain_magnitude") != f.end();
+  };
+  bool need_strain = names_strain(cfg_.params.section("output").strings("fields"));
+  for (const auto& pr : cfg_.params.list("probes"))
+    need_strain = need_strain || (!pr.has("node") && names_strain(pr.strings("fields")));
+  if (need_strain) {
+    reset_F_ = sim_->request_strain_reference();
+    strain_magnitude_ = sim_->request_field(
+        {"strain_magnitude",
+         1,
+         "-",
+         "sqrt(eps:eps) of the logarithmic strain since the last displacement reset",
+         {}});
+  }
   // Every set has the same field layout; a name is known if some set stores it.
   const Particles<D>& p = sim_->sets[0].particles;
   std::vector<std::string> known;
@@ -32,6 +51,7 @@ void Run<D>::check_outputs(Diagnostics& diag) {
     if (stored) known.push_back(p.info(f).name);
   }
   known.push_back("displacement");
+  if (!need_strain) known.push_back("strain_magnitude");
   auto check_name = [&](const Params& sec, size_t i, const std::string& name, bool node) {
     std::vector<std::string> options = known;
     if (node) {
@@ -50,8 +70,10 @@ void Run<D>::check_outputs(Diagnostics& diag) {
   bool need_disp = false;
   for (size_t i = 0; i < names.size(); ++i)
     if (check_name(out, i, names[i], false)) {
-      if (derived_field(names[i]))
+      if (names[i] == "displacement")
         need_disp = true;
+      else if (derived_field(names[i]))
+        continue;  // strain_magnitude: added in the order given below
       else if (names[i] != "position")
         frame_fields_.push_back(p.find(names[i]));  // one layout: valid in every set
     }
@@ -70,7 +92,7 @@ void Run<D>::check_outputs(Diagnostics& diag) {
     for (size_t i = 0; i < f.size(); ++i)
       if (check_name(pr, i, f[i], probe.on_node)) {
         probe.fields.push_back(f[i]);
-        if (derived_field(f[i])) need_disp = true;
+        need_disp = need_disp || f[i] == "displacement";
       }
     if (probe.on_node) {
       size_t idx = 0;
@@ -118,18 +140,13 @@ void Run<D>::check_outputs(Diagnostics& diag) {
         diag.error(cfg_.params.where("probes"), "probes." + std::to_string(i) + ".name",
                    "duplicate probe name '" + probes_[i].name + "'");
   if (need_disp) {
-    initial_position_ = sim_->request_field(
-        {"initial_position", D, "m", "position at t = 0", Particles<D>::axis_names()});
+    initial_position_ = sim_->request_displacement_reference();
     displacement_ = sim_->request_field(
         {"displacement", D, "m", "position minus initial position", Particles<D>::axis_names()});
-    for (auto& s : sim_->sets) {
-      Particles<D>& ps = s.particles;
-      for (int d = 0; d < D; ++d)
-        std::copy(ps.col(ps.position, d), ps.col(ps.position, d) + ps.size(),
-                  ps.col(initial_position_, d));
-    }
-    for (const auto& n : names)
-      if (n == "displacement") frame_fields_.push_back(displacement_);
+  }
+  for (const auto& n : names) {  // in the order given
+    if (n == "displacement") frame_fields_.push_back(displacement_);
+    if (n == "strain_magnitude") frame_fields_.push_back(strain_magnitude_);
   }
 }
 
@@ -156,7 +173,21 @@ std::string Run<D>::prepare_directory() {
 }
 
 template <int D>
+double Run<D>::strain_magnitude(const Particles<D>& p, size_t i) const {
+  double F[D * D], F0[D * D];
+  for (int c = 0; c < D * D; ++c)
+    F[c] = p.col(sim_->deformation_gradient, c)[i], F0[c] = p.col(reset_F_, c)[i];
+  return hencky_strain_norm<D>(F, F0);
+}
+
+template <int D>
 void Run<D>::refresh_derived() {
+  if (strain_magnitude_ >= 0)
+    for (auto& s : sim_->sets) {
+      Particles<D>& p = s.particles;
+      double* out = p.col(strain_magnitude_);
+      for (size_t i = 0; i < p.size(); ++i) out[i] = strain_magnitude(p, i);
+    }
   if (displacement_ < 0) return;
   for (auto& s : sim_->sets) {
     Particles<D>& p = s.particles;
@@ -228,6 +259,10 @@ void Run<D>::sample_probes(bool force) {
         if (f == "displacement") {
           for (int d = 0; d < D; ++d)
             o << "," << p.col(p.position, d)[i] - p.col(initial_position_, d)[i];
+          continue;
+        }
+        if (f == "strain_magnitude") {
+          o << "," << strain_magnitude(p, i);
           continue;
         }
         int h = p.find(f);

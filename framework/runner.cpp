@@ -623,12 +623,22 @@ RunResult Run<D>::loop() {
                                  : stage.until_static ? "not_static"
                                                       : "done";
       stage_records_.push_back(stage_record(status));
-      if (status == "not_static")
-        spdlog::warn(
-            "stage {} '{}' did not reach static within max_time = {} s (particles still "
-            "moving at up to {:.3g} m/s > static_speed = {:.3g} m/s){}",
-            k + 1, stage.name, stage.duration, sim.motion_speed, stage.static_speed,
-            stage.stop_if_not_static ? ": the run stops here (if_not_static: stop)" : "");
+      if (status == "not_static") {
+        // Still too fast, or slow enough only for part of the window at the end.
+        const std::string why =
+            sim.motion_speed > stage.static_speed
+                ? fmt::format(
+                      "particles still moving at up to {:.3g} m/s > static_speed = "
+                      "{:.3g} m/s",
+                      sim.motion_speed, stage.static_speed)
+                : fmt::format(
+                      "particles slower than static_speed = {:.3g} m/s only since t = "
+                      "{:.4g} s, less than static_window = {:.3g} s",
+                      stage.static_speed, ls_.static_since, ls_.static_window);
+        spdlog::warn("stage {} '{}' did not reach static within max_time = {} s ({}){}", k + 1,
+                     stage.name, stage.duration, why,
+                     stage.stop_if_not_static ? ": the run stops here (if_not_static: stop)" : "");
+      }
       if (status == "not_static" && stage.stop_if_not_static && k + 1 < num_stages)
         stopped_by_stage = stage.name;
     }

@@ -391,6 +391,43 @@ void Simulation<D>::restart_displacement(Particles<D>& P, size_t begin, size_t e
   if (!P.has(x0)) return;
   for (int d = 0; d < D; ++d)
     std::copy(P.col(P.position, d) + begin, P.col(P.position, d) + end, P.col(x0, d) + begin);
+  const int F0 = P.find("reset_deformation_gradient");  // the strain output's reference
+  if (!P.has(F0)) return;
+  for (int c = 0; c < D * D; ++c)
+    std::copy(P.col(deformation_gradient, c) + begin, P.col(deformation_gradient, c) + end,
+              P.col(F0, c) + begin);
+}
+
+template <int D>
+int Simulation<D>::request_strain_reference() {
+  request_displacement_reference();  // a reset resets both
+  request_deformation_gradient();
+  FieldInfo info = Particles<D>::deformation_gradient_info();
+  info.name = "reset_deformation_gradient";
+  info.doc = "deformation gradient at the last displacement reset (the identity at t = 0)";
+  const Particles<D>& p0 = sets[0].particles;
+  const bool is_new = !p0.has(p0.find(info.name));
+  const int h = request_field(info);
+  if (is_new)
+    for (auto& s : sets)
+      for (int c = 0; c < D * D; ++c)
+        std::copy(s.particles.col(deformation_gradient, c),
+                  s.particles.col(deformation_gradient, c) + s.particles.size(),
+                  s.particles.col(h, c));
+  return h;
+}
+
+template <int D>
+int Simulation<D>::request_displacement_reference() {
+  const Particles<D>& p0 = sets[0].particles;
+  const bool is_new = !p0.has(p0.find("initial_position"));
+  const int h = request_field({"initial_position", D, "m",
+                               "position at the last displacement reset (t = 0, or a stage's "
+                               "reset: [displacement])",
+                               Particles<D>::axis_names()});
+  if (is_new)
+    for (auto& s : sets) restart_displacement(s.particles, 0, s.particles.size());
+  return h;
 }
 
 template <int D>

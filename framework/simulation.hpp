@@ -298,6 +298,14 @@ class Simulation {
   /// Make the current positions of particles [begin, end) of P their displacement reference
   /// (initial_position, when the output or a reference requested it).
   void restart_displacement(Particles<D>& P, size_t begin, size_t end) const;
+  /// The displacement reference `initial_position` of every set (the output's displacement, a
+  /// stage's reset: [displacement], a reference that measures a failed mass): requested once,
+  /// and set to the current positions when it is new. Returns its field handle.
+  int request_displacement_reference();
+  /// The reference of the strain output (strain_magnitude): the deformation gradient F is
+  /// requested, and its value at the last displacement reset kept as reset_deformation_gradient
+  /// (the identity at t = 0). Returns that field's handle.
+  int request_strain_reference();
   /// The body a plugin names with `key` (the first body when the key is absent), or -1 after a
   /// located "unknown body" error listing the bodies.
   /// With need_particles (loads, references), a body that starts empty (no generator) is an

@@ -221,7 +221,8 @@ class SinglePhase : public Scheme<D> {
   }
 
   /// Nodal forces to updated velocity and acceleration, with loads, face forces, damping and
-  /// the boundary conditions: v^{n+1} = (p + dt f) / m, a = f / m.
+  /// the boundary conditions: v^{n+1} = (p + dt f) / m, a = f / m; a node lighter than
+  /// mass_tolerance keeps p / m without acceleration (light_node_velocity_scale).
   void update_nodes(Simulation<D>& sim, double dt) {
     sim.apply_grid_loads(node_vector(kForce));
     GridForces forces;
@@ -243,7 +244,11 @@ class SinglePhase : public Scheme<D> {
           r[kForce + d] = a;
         }
       } else {
-        for (int d = 0; d < 2 * D; ++d) r[kMomentum + d] = 0.0;
+        const double v_scale = light_node_velocity_scale(r[kMass]);
+        for (int d = 0; d < D; ++d) {
+          r[kMomentum + d] *= v_scale;
+          r[kForce + d] = 0.0;
+        }
       }
     });
     GridUpdate u;
@@ -252,16 +257,19 @@ class SinglePhase : public Scheme<D> {
     sim.constrain_update(u);
   }
 
-  /// Velocity from momentum in vel_ (MUSL re-map, USF), constrained.
+  /// Velocity from momentum in vel_ (MUSL re-map, USF), constrained: every node with mass
+  /// (update_nodes says why the light ones too).
   void momentum_to_velocity(Simulation<D>& sim, const double* momentum, int stride, int offset) {
     const double tol = sim.mass_tolerance;
     const double* node = node_.data();
     double* vel = vel_.data();
     for_each_node(sim.grid.num_nodes, sim.threads, [=](size_t i) {
       const double m = node[i * S + kMass];
-      for (int d = 0; d < D; ++d)
-        vel[i * D + size_t(d)] =
-            m > tol ? momentum[i * size_t(stride) + size_t(offset + d)] / m : 0.0;
+      const double light = light_node_velocity_scale(m);
+      for (int d = 0; d < D; ++d) {
+        const double p = momentum[i * size_t(stride) + size_t(offset + d)];
+        vel[i * D + size_t(d)] = m > tol ? p / m : p * light;
+      }
     });
     sim.constrain(vel_vector());
   }

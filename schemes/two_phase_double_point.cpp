@@ -601,10 +601,13 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       double* solved = solved_.data() + i * 2 * D;
       const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
       const bool has_s = ms > tol, has_w = mw > tol;
+      // A light phase keeps its points' mean velocity p / m, without acceleration
+      // (light_node_velocity_scale).
+      const double light_s = light_node_velocity_scale(ms), light_w = light_node_velocity_scale(mw);
       for (int d = 0; d < D; ++d) {
         const double v = has_s ? r[kV + d] / ms : 0.0, w = has_w ? r[kW + d] / mw : 0.0;
         const double Fs = r[kF + d], Fw = r[kFw + d];
-        double vn = 0, wn = 0;
+        double vn = r[kV + d] * light_s, wn = r[kW + d] * light_w;
         if (has_s && has_w) {
           const auto s = solve_drag_implicit(ms, mw, Q, dt, ms * v / dt + Fs, mw * w / dt + Fw);
           vn = s.solid, wn = s.water;
@@ -681,9 +684,11 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     for_each_record(sim, [&](const double* g, size_t i) {
       const double ms = g[kMs], mw = g[kMw];
       double* r = remap_.data() + i * 2 * D;
+      // Light nodes too (light_node_velocity_scale): their p / m, not zero.
+      const double light_s = light_node_velocity_scale(ms), light_w = light_node_velocity_scale(mw);
       for (int d = 0; d < D; ++d) {
-        r[d] = ms > tol ? r[d] / ms : 0.0;
-        r[D + d] = mw > tol ? r[D + d] / mw : 0.0;
+        r[d] = ms > tol ? r[d] / ms : r[d] * light_s;
+        r[D + d] = mw > tol ? r[D + d] / mw : r[D + d] * light_w;
       }
     });
     sim.constrain(NodalVector{remap_.data(), 2 * D, 0});

@@ -410,9 +410,15 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     for_each_record(sim, [&](double* r, size_t i) {
       double* solved = solved_.data() + i * 2 * D;
       const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
-      if (ms <= tol) {
-        for (int c = kV; c < S; ++c) r[c] = 0.0;
-        for (int c = 0; c < 2 * D; ++c) solved[c] = 0.0;
+      if (ms <= tol) {  // a light node: its particles' mean velocities, no acceleration
+        const double ss = light_node_velocity_scale(ms), sw = light_node_velocity_scale(mw);
+        for (int d = 0; d < D; ++d) {
+          const double v = r[kV + d] * ss;
+          r[kV + d] = solved[d] = v;
+          r[kW + d] = solved[D + d] = sw > 0 ? r[kW + d] * sw : v;
+          r[kF + d] = r[kFw + d] = 0.0;
+        }
+        r[kQ] = r[kN] = 0.0;
         return;
       }
       for (int d = 0; d < D; ++d) {
@@ -464,9 +470,11 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     for_each_record(sim, [&](const double* g, size_t i) {
       const double ms = g[kMs], mw = g[kMw];
       double* r = remap_.data() + i * 2 * D;
+      // Light nodes too (light_node_velocity_scale): their p / m, not zero.
+      const double ss = light_node_velocity_scale(ms), sw = light_node_velocity_scale(mw);
       for (int d = 0; d < D; ++d) {
-        r[d] = ms > tol ? r[d] / ms : 0.0;
-        r[D + d] = mw > tol ? r[D + d] / mw : r[d];
+        r[d] = ms > tol ? r[d] / ms : r[d] * ss;
+        r[D + d] = mw > tol ? r[D + d] / mw : sw > 0 ? r[D + d] * sw : r[d];
       }
     });
     sim.constrain(NodalVector{remap_.data(), 2 * D, 0});

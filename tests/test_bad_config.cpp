@@ -456,7 +456,7 @@ output:
                    {s.error_at(13, 7, "output.fields.1",
                                "unknown particle field 'strees'; did you mean 'stress'? "
                                "available fields: position, velocity, mass, volume, stress, "
-                               "displacement")});
+                               "displacement, strain_magnitude")});
 }
 
 TEST_CASE("a probe naming both particle_near and node", "[bad_config]") {

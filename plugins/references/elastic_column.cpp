@@ -40,11 +40,7 @@ class ElasticColumn : public Reference<D> {
     base_ = b.lower[D - 1];
     H_ = b.upper[D - 1] - base_;
     M_ = E_ * (1 - nu_) / ((1 + nu_) * (1 - 2 * nu_));
-    auto& P = sim.particles_of_body(body_);
-    z0_ = sim.request_field(
-        {"initial_position", D, "m", "position at t = 0", Particles<D>::axis_names()});
-    for (int d = 0; d < D; ++d)
-      std::copy(P.col(P.position, d), P.col(P.position, d) + P.size(), P.col(z0_, d));
+    z0_ = sim.request_displacement_reference();
   }
 
   std::map<std::string, double> metrics(Simulation<D>& sim) override {
