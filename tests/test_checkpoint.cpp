@@ -256,3 +256,18 @@ TEST_CASE(
                             "be checkpointed yet (its state is not saved)") != std::string::npos);
   CHECK(!fs::exists(a.path / "refused"));
 }
+
+TEST_CASE(
+    "a resumed slope failure (slope_failure's per-point state) is bitwise the same, 1 and 2 "
+    "threads",
+    "[checkpoint][slope]") {
+  // The quick variant of configs/seed002_slope_frictional.yaml (1 m cells), resumed at step
+  // 5000, inside the stage after the strength drop: slope_failure carries every point's last
+  // position and last fast sample (time_to_rest) and its series across the checkpoint.
+  for (const char* threads : {"1", "2"})
+    check_resume("seed002_slope_frictional.yaml",
+                 std::string("--threads ") + threads +
+                     " --set grid.cell_size=1 --set stages.3.duration=10"
+                     " --set stages.0.static_speed=1e-4 --set stages.1.static_speed=1e-4",
+                 500, 5000);
+}

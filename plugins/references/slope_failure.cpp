@@ -86,6 +86,7 @@ class SlopeFailure : public Reference<D> {
     if (body_ < 0) return;
     const Body& b = sim.bodies[size_t(body_)];
     first_id_ = b.first_id;
+    count_ = b.count;
     bottom_ = b.lower[D - 1];
     for (int d = 0; d < D; ++d) half_[size_t(d)] = 0.5 * b.spacing[size_t(d)];
     x_ref_ = sim.request_displacement_reference();
@@ -105,7 +106,7 @@ class SlopeFailure : public Reference<D> {
     long n = 0;
     const double interval = sim.time - t_prev_;
     for (size_t i = 0; i < P.size(); ++i) {
-      if (P.body[i] != body_) continue;
+      if (!measured(P, i)) continue;
       const size_t k = P.id[i] - first_id_;
       double* prev = &prev_[size_t(D) * k];
       double u2 = 0, s2 = 0;
@@ -139,7 +140,7 @@ class SlopeFailure : public Reference<D> {
     double depth = 0, base = std::numeric_limits<double>::infinity(), front = -base;
     double top_moved = -base, volume = 0, surface = -base, moving_until = 0;
     for (size_t i = 0; i < P.size(); ++i) {
-      if (P.body[i] != body_) continue;
+      if (!measured(P, i)) continue;
       const double y = P.col(P.position, D - 1)[i];
       if (!surface_at_.empty() && on_line(P, i)) surface = std::max(surface, y + half_[D - 1]);
       if (displacement(P, i) <= moved_) continue;
@@ -209,15 +210,21 @@ class SlopeFailure : public Reference<D> {
   /// Begin the measurement at time t0 from the displacement reference (the reset positions).
   void restart(const Simulation<D>& sim, double t0) {
     const Particles<D>& P = sim.particles_of_body(body_);
-    prev_.assign(size_t(D) * sim.bodies[size_t(body_)].count, 0.0);
-    last_fast_.assign(sim.bodies[size_t(body_)].count, 0.0);
+    prev_.assign(size_t(D) * count_, 0.0);
+    last_fast_.assign(count_, 0.0);
     for (size_t i = 0; i < P.size(); ++i)
-      if (P.body[i] == body_)
+      if (measured(P, i))
         for (int d = 0; d < D; ++d)
           prev_[size_t(D) * (P.id[i] - first_id_) + size_t(d)] = P.col(x_ref_, d)[i];
     t0_ = t_prev_ = t0;
     clock_.restart();
     time_.clear(), max_u_.clear(), mean_u_.clear(), speed_.clear();
+  }
+
+  /// Whether particle i is one of the body's own (generated with it, ids [first_id, +count));
+  /// a particle a source adds later is not measured.
+  bool measured(const Particles<D>& P, size_t i) const {
+    return P.body[i] == body_ && size_t(P.id[i]) - first_id_ < count_;
   }
 
   double displacement(const Particles<D>& P, size_t i) const {
@@ -257,7 +264,7 @@ class SlopeFailure : public Reference<D> {
     }
     std::vector<double> top(n, -std::numeric_limits<double>::infinity());
     for (size_t i = 0; i < P.size(); ++i)
-      if (P.body[i] == body_) {
+      if (measured(P, i)) {
         double& t = top[column_of(P, i)];
         t = std::max(t, P.col(x_ref_, D - 1)[i] + half_[D - 1]);
       }
@@ -270,7 +277,7 @@ class SlopeFailure : public Reference<D> {
   double rest_speed_;
   SampleClock clock_;
   int body_ = -1, x_ref_ = -1, stage_ = -1;
-  size_t first_id_ = 0;
+  size_t first_id_ = 0, count_ = 0;
   double bottom_ = 0, t0_ = 0, t_prev_ = 0;
   std::array<double, D> half_{};
   std::array<double, D> origin_{};
