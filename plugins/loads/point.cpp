@@ -1,5 +1,7 @@
 // Point force (N; N per unit thickness in 2D) at a fixed position, distributed to the nodes of
-// the cell containing it with linear weights, ramped linearly over ramp_time.
+// the cell containing it with linear weights, scaled by its time function (or ramped linearly
+// over ramp_time).
+#include "framework/load_time.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 
@@ -15,10 +17,10 @@ class PointLoad : public Load<D> {
     Schema s;
     s.vector("position", "m", "where the force acts").required();
     s.vector("force", "N", "force vector").required();
-    s.real("ramp_time", "s", "linear ramp from 0 to full load").def("0").min(0);
+    add_load_time_keys(s);
     return s;
   }
-  explicit PointLoad(const Params& p) : params_(p), ramp_(p.real("ramp_time")) {
+  explicit PointLoad(const Params& p) : params_(p), time_(p) {
     for (int d = 0; d < D; ++d) {
       x_[size_t(d)] = p.vec("position")[size_t(d)];
       f_[size_t(d)] = p.vec("force")[size_t(d)];
@@ -46,14 +48,14 @@ class PointLoad : public Load<D> {
     }
   }
   void apply_to_grid(Simulation<D>&, const NodalVector& force, double t) override {
-    const double s = ramp_factor(t, ramp_);
+    const double s = time_(t);
     for (size_t k = 0; k < nodes_.size(); ++k)
       for (int d = 0; d < D; ++d) force.at(nodes_[k], d) += s * weights_[k] * f_[size_t(d)];
   }
 
  private:
   Params params_;
-  double ramp_;
+  LoadTime<D> time_;
   std::array<double, D> x_{}, f_{};
   std::vector<size_t> nodes_;
   std::vector<double> weights_;

@@ -1,7 +1,7 @@
 // Surface traction (Pa) on the particles of a body face or of a named particle set. Each
 // particle carries the force t * A_p, with A_p = V_p / s the particle's share of the face
-// (s: particle spacing normal to the face, both at the start: a nominal traction), ramped
-// linearly from 0 over ramp_time.
+// (s: particle spacing normal to the face, both at the start: a nominal traction), scaled by
+// its time function (framework/load_time.hpp; or ramped linearly from 0 over ramp_time).
 //
 // apply_at: particle (default) adds the force to the particle, so it reaches the nodes with the
 // particle's own weights, i.e. at the particle centre, half a particle below the real surface.
@@ -22,6 +22,7 @@
 #include <cmath>
 #include <map>
 
+#include "framework/load_time.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 
@@ -44,7 +45,7 @@ class Traction : public Load<D> {
     s.choice("face", face_names(), "face (of the body) the traction acts on; sets the loaded area")
         .required();
     s.vector("traction", "Pa", "traction vector (force per unit area)").required();
-    s.real("ramp_time", "s", "linear ramp from 0 to full load").def("0").min(0);
+    add_load_time_keys(s);
     s.choice("apply_at", {"particle", "surface"},
              "particle: the force acts at the particle centre (particle weights); surface: at "
              "the particle's current surface point x_p + F (s/2) N (the centre of its loaded face "
@@ -63,7 +64,7 @@ class Traction : public Load<D> {
   explicit Traction(const Params& p)
       : params_(p),
         face_(parse_face(p.text("face"))),
-        ramp_(p.real("ramp_time")),
+        time_(p),
         surface_(p.text("apply_at") == "surface") {
     for (int d = 0; d < D; ++d) t_[size_t(d)] = p.vec("traction")[size_t(d)];
   }
@@ -116,7 +117,7 @@ class Traction : public Load<D> {
 
   void apply_to_grid(Simulation<D>& sim, const NodalVector& force, double t) override {
     if (!surface_) return;
-    const double s = ramp_factor(t, ramp_);
+    const double s = time_(t);
     const auto& set = sim.sets[size_t(set_)];
     const auto& P = set.particles;
     const Grid<D>& g = sim.grid;
@@ -150,7 +151,7 @@ class Traction : public Load<D> {
 
   void apply_to_particles(Simulation<D>& sim, double t) override {
     if (surface_) return;
-    const double s = ramp_factor(t, ramp_);
+    const double s = time_(t);
     auto& set = sim.sets[size_t(set_)];
     auto& P = set.particles;
     for (size_t k = 0; k < ids_.size(); ++k) {
@@ -193,7 +194,7 @@ class Traction : public Load<D> {
 
   Params params_;
   Face face_;
-  double ramp_;
+  LoadTime<D> time_;
   bool surface_;
   int F_ = -1;
   int set_ = 0;                 // the set of the loaded particles
