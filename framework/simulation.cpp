@@ -389,13 +389,16 @@ template <int D>
 void Simulation<D>::restart_displacement(Particles<D>& P, size_t begin, size_t end) const {
   const int x0 = P.find("initial_position");  // the output's displacement reference
   if (!P.has(x0)) return;
-  for (int d = 0; d < D; ++d)
-    std::copy(P.col(P.position, d) + begin, P.col(P.position, d) + end, P.col(x0, d) + begin);
+  copy_columns(P, P.position, x0, D, begin, end);
   const int F0 = P.find("reset_deformation_gradient");  // the strain output's reference
-  if (!P.has(F0)) return;
-  for (int c = 0; c < D * D; ++c)
-    std::copy(P.col(deformation_gradient, c) + begin, P.col(deformation_gradient, c) + end,
-              P.col(F0, c) + begin);
+  if (P.has(F0)) copy_columns(P, deformation_gradient, F0, D * D, begin, end);
+}
+
+template <int D>
+void Simulation<D>::copy_columns(Particles<D>& P, int from, int to, int components, size_t begin,
+                                 size_t end) {
+  for (int c = 0; c < components; ++c)
+    std::copy(P.col(from, c) + begin, P.col(from, c) + end, P.col(to, c) + begin);
 }
 
 template <int D>
@@ -409,11 +412,7 @@ int Simulation<D>::request_strain_reference() {
   const bool is_new = !p0.has(p0.find(info.name));
   const int h = request_field(info);
   if (is_new)
-    for (auto& s : sets)
-      for (int c = 0; c < D * D; ++c)
-        std::copy(s.particles.col(deformation_gradient, c),
-                  s.particles.col(deformation_gradient, c) + s.particles.size(),
-                  s.particles.col(h, c));
+    for (auto& s : sets) copy_columns(s.particles, deformation_gradient, h, D * D, 0, s.size());
   return h;
 }
 

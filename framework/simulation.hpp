@@ -298,6 +298,9 @@ class Simulation {
   /// Make the current positions of particles [begin, end) of P their displacement reference
   /// (initial_position, when the output or a reference requested it).
   void restart_displacement(Particles<D>& P, size_t begin, size_t end) const;
+  /// Copy `components` columns of field `from` into field `to` for particles [begin, end).
+  static void copy_columns(Particles<D>& P, int from, int to, int components, size_t begin,
+                           size_t end);
   /// The displacement reference `initial_position` of every set (the output's displacement, a
   /// stage's reset: [displacement], a reference that measures a failed mass): requested once,
   /// and set to the current positions when it is new. Returns its field handle.

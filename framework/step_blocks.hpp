@@ -81,6 +81,12 @@ inline double light_node_velocity_scale(double m) {
   return m > 1e-290 ? 1 / m : 0.0;
 }
 
+/// A node's velocity from its momentum p and mass m: p / m, for a light node too
+/// (light_node_velocity_scale); 0 without mass.
+LOAM_FORCE_INLINE double node_velocity(double p, double m, double mass_tolerance) {
+  return m > mass_tolerance ? p / m : p * light_node_velocity_scale(m);
+}
+
 /// The FLIP/PIC blend of the particle velocity update: FLIP adds the interpolated grid
 /// acceleration to the particle's own velocity (no dissipation, noisy where nodes are nearly
 /// empty), PIC takes the interpolated grid velocity (smooth, dissipative); `flip` in [0, 1].

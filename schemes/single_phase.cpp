@@ -265,11 +265,9 @@ class SinglePhase : public Scheme<D> {
     double* vel = vel_.data();
     for_each_node(sim.grid.num_nodes, sim.threads, [=](size_t i) {
       const double m = node[i * S + kMass];
-      const double light = light_node_velocity_scale(m);
-      for (int d = 0; d < D; ++d) {
-        const double p = momentum[i * size_t(stride) + size_t(offset + d)];
-        vel[i * D + size_t(d)] = m > tol ? p / m : p * light;
-      }
+      for (int d = 0; d < D; ++d)
+        vel[i * D + size_t(d)] =
+            node_velocity(momentum[i * size_t(stride) + size_t(offset + d)], m, tol);
     });
     sim.constrain(vel_vector());
   }

@@ -684,11 +684,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     for_each_record(sim, [&](const double* g, size_t i) {
       const double ms = g[kMs], mw = g[kMw];
       double* r = remap_.data() + i * 2 * D;
-      // Light nodes too (light_node_velocity_scale): their p / m, not zero.
-      const double light_s = light_node_velocity_scale(ms), light_w = light_node_velocity_scale(mw);
       for (int d = 0; d < D; ++d) {
-        r[d] = ms > tol ? r[d] / ms : r[d] * light_s;
-        r[D + d] = mw > tol ? r[D + d] / mw : r[D + d] * light_w;
+        r[d] = node_velocity(r[d], ms, tol);
+        r[D + d] = node_velocity(r[D + d], mw, tol);
       }
     });
     sim.constrain(NodalVector{remap_.data(), 2 * D, 0});

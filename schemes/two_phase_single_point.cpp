@@ -470,11 +470,11 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     for_each_record(sim, [&](const double* g, size_t i) {
       const double ms = g[kMs], mw = g[kMw];
       double* r = remap_.data() + i * 2 * D;
-      // Light nodes too (light_node_velocity_scale): their p / m, not zero.
-      const double ss = light_node_velocity_scale(ms), sw = light_node_velocity_scale(mw);
+      // Light nodes too (node_velocity); water without mass follows the solid.
+      const bool has_water = mw > tol || light_node_velocity_scale(mw) > 0;
       for (int d = 0; d < D; ++d) {
-        r[d] = ms > tol ? r[d] / ms : r[d] * ss;
-        r[D + d] = mw > tol ? r[D + d] / mw : sw > 0 ? r[D + d] * sw : r[d];
+        r[d] = node_velocity(r[d], ms, tol);
+        r[D + d] = has_water ? node_velocity(r[D + d], mw, tol) : r[d];
       }
     });
     sim.constrain(NodalVector{remap_.data(), 2 * D, 0});
