@@ -85,6 +85,8 @@ struct GridForces {
   /// Single-phase schemes: the nodal mass mass.at(n, 0) and momentum of the step, which a
   /// condition may change together with the force (periodic joins node pairs); else null.
   NodalVector mass{nullptr, 0, 0}, momentum{nullptr, 0, 0};
+  /// The loads' time (since the stage that set the running loads began), for time functions.
+  double time = 0;
 };
 
 template <int D>
@@ -95,6 +97,11 @@ class Boundary {
   virtual void setup(Simulation<D>&, Diagnostics&) {}
   /// Add face forces to the nodal forces of a step, before the grid update (default: none).
   virtual void add_forces(const GridForces&) const {}
+  /// Checkpoints (output.checkpoint): a condition's state measured during the run (e.g. the
+  /// reaction an absorbing face took over at its first step), appended as doubles and restored
+  /// bit for bit on --resume. false (default): it has none.
+  virtual bool save_state(std::vector<double>&) const { return false; }
+  virtual void restore_state(const std::vector<double>&) {}
   /// Zero the constrained components of `v` (a velocity, momentum, acceleration or force). On
   /// the MUSL re-mapped velocities this is the only call (Simulation::constrain): holds only, no
   /// friction impulse, since the particles already carry the step's impulse from the update.

@@ -204,6 +204,9 @@ typename Run<D>::CheckpointImage Run<D>::checkpoint_image() {
   for (size_t i = 0; i < sim.sources.size(); ++i)
     if (state.clear(), sim.sources[i]->save_state(state))
       image.plugins.emplace_back("plugin.source." + std::to_string(i), state);
+  for (size_t i = 0; i < sim.boundaries.size(); ++i)
+    if (state.clear(), sim.boundaries[i]->save_state(state))
+      image.plugins.emplace_back("plugin.boundary." + std::to_string(i), state);
   return image;
 }
 
@@ -325,6 +328,12 @@ void Run<D>::restore_checkpoint() {
   stage_records_ = nlohmann::json::parse(r.text("run.stages"));
   // The plugins of the stages begun so far (their particle changes are in the checkpoint).
   for (int k = 0; k <= sim.stage; ++k) sim.swap_stage_plugins(k);
+  // The current stage's conditions with a measured state (the config and the stage decide which,
+  // so the checkpoint has an array for each that saves one).
+  std::vector<double> probe;
+  for (size_t i = 0; i < sim.boundaries.size(); ++i)
+    if (probe.clear(), sim.boundaries[i]->save_state(probe))
+      sim.boundaries[i]->restore_state(r.doubles("plugin.boundary." + std::to_string(i)));
   // The checkpoints of the run so far, and none from beyond this one (that future is redone).
   for (const auto& file : checkpoint_files(dir_)) {
     if (checkpoint_step(file) > sim.step) {

@@ -191,7 +191,8 @@ class Simulation {
     materials[set.particles.material[b]]->update_stress(batch);
   }
   /// Face forces of the boundary conditions (GridForces), before the grid update.
-  void apply_boundary_forces(const GridForces& f) const {
+  void apply_boundary_forces(GridForces f) const {
+    f.time = time - loads_start;
     for (const auto& b : boundaries) b->add_forces(f);
   }
   void apply_grid_loads(const NodalVector& force) {

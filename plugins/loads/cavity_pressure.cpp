@@ -1,0 +1,184 @@
+// Pressure on the wall of a cavity inside a body: a borehole charge, a pressurised tunnel, a
+// cavity expansion. The cavity is a generator region that describes its surface (sphere,
+// cylinder); usually the same region the body's `difference` generator left empty. Its wall is
+// sampled with quadrature points x_q (normal n_q, area A_q, about a quarter particle spacing apart,
+// Generator::surface_samples, whose areas sum to the wall's exactly), and each sample's force
+// goes to the body particle nearest to it:
+//   f_p = p f(t) sum_{q -> p} A_q n_q,
+// n_q the cavity's outward normal (away from the cavity, into the body). So the loaded area and
+// the resultant are the wall's to round-off, whatever the lattice, and each wall particle is
+// pushed along its own share of the wall's normal. Samples the body does not cover (beyond a
+// quarter model's symmetry planes: the body's region does not hold x_q + (s/2) n_q, s the particle
+// spacing) are dropped, as are samples with no body particle within 2 s. Normals and areas are
+// those of the reference configuration (a nominal pressure, as `traction`'s); the forces act at
+// the particle centres.
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "framework/load_time.hpp"
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+
+namespace loam {
+
+template <int D>
+class CavityPressure : public Load<D> {
+ public:
+  static constexpr const char* name = "cavity_pressure";
+  static constexpr const char* summary =
+      "pressure on a cavity's wall (borehole, tunnel): each wall particle pushed along its own "
+      "outward normal";
+  static Schema schema() {
+    Schema s;
+    s.text("body", "body around the cavity").required();
+    s.plugin("cavity", "generator",
+             "the cavity: a region that describes its surface (sphere, cylinder); only its wall "
+             "is loaded (not a cylinder's ends)")
+        .required();
+    s.real("pressure", "Pa", "pressure in the cavity (positive pushes the wall outwards)")
+        .required();
+    add_load_time_keys(s);
+    return s;
+  }
+  explicit CavityPressure(const Params& p)
+      : params_(p),
+        cavity_(Registry::instance().create<Generator, D>(p.section("cavity"))),
+        pressure_(p.real("pressure")),
+        time_(p) {}
+  bool uses_particle_forces() const override { return true; }
+
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    if (std::string problem = cavity_->check(); !problem.empty()) {
+      diag.error(params_.where("cavity"), params_.path("cavity"), problem);
+      return;
+    }
+    if (!cavity_->describes_surface()) {
+      diag.error(params_.where("cavity"), params_.path("cavity"),
+                 "a '" + params_.section("cavity").type() +
+                     "' region does not describe its surface; a cavity is a sphere or a "
+                     "cylinder");
+      return;
+    }
+    const int b = sim.body_param(params_, "body", diag);
+    if (b < 0) return;
+    const Body& body = sim.bodies[size_t(b)];
+    if (!body.params.has("generator")) {
+      diag.error(params_.where("body"), params_.path("body"),
+                 "body '" + body.name + "' starts empty (no generator): it has no cavity wall");
+      return;
+    }
+    const auto region = Registry::instance().create<Generator, D>(body.params.section("generator"));
+    set_ = sim.body_set(b);
+    if (const size_t inside = count_inside(sim, b); inside > 0) {
+      diag.error(params_.where("cavity"), params_.path("cavity"),
+                 "the cavity holds " + std::to_string(inside) + " particles of body '" + body.name +
+                     "': a cavity is empty (subtract it from the body's region with a "
+                     "`difference` generator)");
+      return;
+    }
+    double s = 0;  // the body's largest particle spacing
+    for (double h : body.spacing) s = std::max(s, h);
+    assign_samples(sim, b, *region, s);
+    if (ids_.empty())
+      diag.error(params_.where("cavity"), params_.path("cavity"),
+                 "no particle of body '" + body.name +
+                     "' lies on the cavity's wall (within two particle spacings of it)");
+  }
+
+  void apply_to_particles(Simulation<D>& sim, double t) override {
+    const double p = pressure_ * time_(t);
+    auto& set = sim.sets[size_t(set_)];
+    auto& P = set.particles;
+    for (size_t k = 0; k < ids_.size(); ++k) {
+      const size_t i = set.index_of(ids_[k]);
+      for (int d = 0; d < D; ++d) P.col(sim.external_force, d)[i] += p * area_vector_[k][size_t(d)];
+    }
+  }
+
+  /// The loaded particles' ids and their area vectors A_p n_p (for tests and references).
+  const std::vector<uint32_t>& ids() const { return ids_; }
+  const std::vector<std::array<double, D>>& area_vectors() const { return area_vector_; }
+
+ private:
+  using Cell = std::array<long, D>;
+  static Cell cell_of(const std::array<double, D>& x, double s) {
+    Cell c{};
+    for (int d = 0; d < D; ++d) c[size_t(d)] = long(std::floor(x[size_t(d)] / s));
+    return c;
+  }
+
+  size_t count_inside(const Simulation<D>& sim, int b) const {
+    const auto& P = sim.sets[size_t(set_)].particles;
+    size_t n = 0;
+    for (size_t i = 0; i < P.size(); ++i) {
+      if (P.body[i] != b) continue;
+      std::array<double, D> x{};
+      for (int d = 0; d < D; ++d) x[size_t(d)] = P.col(P.position, d)[i];
+      n += cavity_->contains(x);
+    }
+    return n;
+  }
+
+  /// Each wall sample's area vector A_q n_q to the nearest body particle (within 2 s), found
+  /// through a hash of the particles near the cavity by cells of size s.
+  void assign_samples(const Simulation<D>& sim, int b, const Generator<D>& region, double s) {
+    const auto& P = sim.sets[size_t(set_)].particles;
+    const auto lo = cavity_->lower(), hi = cavity_->upper();
+    std::map<Cell, std::vector<size_t>> near;
+    for (size_t i = 0; i < P.size(); ++i) {
+      if (P.body[i] != b) continue;
+      std::array<double, D> x{};
+      bool close = true;
+      for (int d = 0; d < D; ++d) {
+        x[size_t(d)] = P.col(P.position, d)[i];
+        close =
+            close && x[size_t(d)] > lo[size_t(d)] - 3 * s && x[size_t(d)] < hi[size_t(d)] + 3 * s;
+      }
+      if (close) near[cell_of(x, s)].push_back(i);
+    }
+    std::map<size_t, std::array<double, D>> share;  // particle index -> sum A_q n_q
+    for (const auto& q : cavity_->surface_samples(s / 4)) {
+      std::array<double, D> outside{};
+      for (int d = 0; d < D; ++d)
+        outside[size_t(d)] = q.x[size_t(d)] + 0.5 * s * q.normal[size_t(d)];
+      if (!region.contains(outside)) continue;  // not on this body's wall
+      const Cell c = cell_of(q.x, s);
+      size_t best = SIZE_MAX;
+      double best_r2 = 4 * s * s;
+      for (int k = 0; k < int(std::pow(5, D)); ++k) {  // the cells within 2 of c
+        Cell n = c;
+        for (int d = 0, r = k; d < D; ++d, r /= 5) n[size_t(d)] += r % 5 - 2;
+        const auto it = near.find(n);
+        if (it == near.end()) continue;
+        for (size_t i : it->second) {
+          double r2 = 0;
+          for (int d = 0; d < D; ++d) {
+            const double e = P.col(P.position, d)[i] - q.x[size_t(d)];
+            r2 += e * e;
+          }
+          if (r2 < best_r2 || (r2 == best_r2 && i < best)) best_r2 = r2, best = i;
+        }
+      }
+      if (best == SIZE_MAX) continue;
+      auto& a = share[best];
+      for (int d = 0; d < D; ++d) a[size_t(d)] += q.area * q.normal[size_t(d)];
+    }
+    for (const auto& [i, a] : share) {
+      ids_.push_back(P.id[i]);
+      area_vector_.push_back(a);
+    }
+  }
+
+  Params params_;
+  std::unique_ptr<Generator<D>> cavity_;
+  double pressure_;
+  LoadTime<D> time_;
+  int set_ = 0;
+  std::vector<uint32_t> ids_;
+  std::vector<std::array<double, D>> area_vector_;
+};
+
+LOAM_REGISTER(Load, CavityPressure)
+
+}  // namespace loam
