@@ -278,7 +278,7 @@ time:
   require_rejected(s, r,
                    {s.error_at(6, 16, "bodies.0.generator.type",
                                "missing required key 'type' (a generator; valid types are: box, "
-                               "polygon, sphere)")});
+                               "cylinder, difference, intersection, polygon, sphere)")});
 }
 
 TEST_CASE("an unknown plugin name suggests the closest one and lists the valid ones",

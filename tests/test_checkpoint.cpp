@@ -125,6 +125,18 @@ TEST_CASE("a resumed double-point run is bitwise the uninterrupted one, 1 and 2 
         1000, 4000);
 }
 
+TEST_CASE("a resumed blast (absorbing free_field faces, blast_wave) is bitwise the same",
+          "[checkpoint][blast]") {
+  // configs/seed002_blast_3d.yaml on 2 m cells to 0.01 s (25 steps): the absorbing faces'
+  // free-field reactions of the first step and the reference's probe series cross the
+  // checkpoint of step 10.
+  for (const char* threads : {"1", "2"})
+    check_resume("seed002_blast_3d.yaml",
+                 std::string("--threads ") + threads +
+                     " --set grid.cell_size=2 --set time.end=0.01 --set output.every_time=0.002",
+                 5, 10);
+}
+
 TEST_CASE("an unstable run checkpoints its last good state and resuming it fails the same way",
           "[checkpoint][stability]") {
   // The seed-001 column with USL, k = 10 m/s and cfl 0.8 (above its critical 0.755,
