@@ -34,7 +34,15 @@
 // Very brittle softening (a drop of strength over a strain range that is small against the
 // strength over the elastic modulus) gives a local snap-back, where r(x) may have several
 // roots; the solve then returns one bracketed root (after 60 returns, the last iterate).
-// Mesh-dependent localisation of softening models is not regularised (no length scale).
+// Regularisation (optional `characteristic_length` l_c): a softening band localises into about
+// one particle (or cell) width, so the strain range over which the strength falls, and with it
+// the energy dissipated in the band, shrinks with the resolution. With l_c the softening
+// strains are given for a band of width l_c and scaled to the particle size l_p of the body
+// (l_p = V_p^(1/D) at set-up, the lattice spacing), softening_start l_c / l_p and
+// softening_end l_c / l_p: the displacement across the band over which the strength falls,
+// (softening_end - softening_start) l_c, and the fracture energy per unit band area are then
+// independent of the resolution (Pietruszczak & Mroz 1981, the crack-band idea of Bazant &
+// Oh 1983). Without it the strains apply as given at every resolution (mesh-dependent).
 #include <cmath>
 #include <limits>
 #include <string>
@@ -87,6 +95,11 @@ class StrainSofteningMC : public Material<D> {
            "largest principal stress (tension positive), constant; capped by the current apex "
            "c/tan(phi); default: the apex")
         .non_negative();
+    s.real("characteristic_length", "m",
+           "regularisation: the softening strains hold for a band this wide; each body scales "
+           "them by characteristic_length / (its particle size), so the displacement over which "
+           "a band softens does not depend on the resolution (default: no scaling)")
+        .positive();
     s.check([](const Params& p, Diagnostics& d) {
       auto fmt = [&](const char* k) { return std::string(k) + " = " + format_number(p.real(k)); };
       for (const char* q : {"c", "phi", "psi"}) {
@@ -125,6 +138,7 @@ class StrainSofteningMC : public Material<D> {
     lambda_ = E_ * nu_ / ((1 + nu_) * (1 - 2 * nu_));
     M_ = lambda_ + 2 * G_;
     constant_ = c_[0] == c_[1] && phi_[0] == phi_[1] && psi_[0] == psi_[1];
+    if (p.has("characteristic_length")) length_ = p.real("characteristic_length");
   }
 
   double density() const override { return rho_; }
@@ -132,7 +146,15 @@ class StrainSofteningMC : public Material<D> {
   void setup(Simulation<D>& sim, int m, Diagnostics&) override {
     const int set = sim.body_set(m);  // state fields live in the set of the body
     eq_ = sim.request_field(plastic_strain_eq_field(), set);
+    scale_ = 1;
+    if (length_ > 0) {
+      double volume = 1;
+      for (double h : sim.bodies[size_t(m)].spacing) volume *= h;
+      scale_ = length_ / std::pow(volume, 1.0 / D);
+    }
   }
+  /// The softening strains' scale l_c / l_p (1 without characteristic_length).
+  double softening_scale() const { return scale_; }
 
   double wave_speed(const Particles<D>& P, size_t b, size_t e) const override {
     return p_wave_speed(P, b, e, M_);  // elastic P-wave speed bounds the plastic one
@@ -153,7 +175,8 @@ class StrainSofteningMC : public Material<D> {
 
   /// The yield surface with the parameters at equivalent plastic strain x.
   MohrCoulombSurface surface(double x) const {
-    const double t = std::clamp((x - start_) / (end_ - start_), 0.0, 1.0);
+    const double t =
+        std::clamp((x - start_ * scale_) / (end_ * scale_ - start_ * scale_), 0.0, 1.0);
     auto at = [t](const double(&v)[2]) {
       return t == 0 ? v[0] : t == 1 ? v[1] : v[0] + t * (v[1] - v[0]);
     };
@@ -178,7 +201,8 @@ class StrainSofteningMC : public Material<D> {
       Vec3 sp;
       double deq = 0;
       s0.return_principal(pr.values, sp, deq);
-      if (!constant_ && xn < end_ && xn + deq > start_) consistent_return(pr.values, xn, sp, deq);
+      if (!constant_ && xn < end_ * scale_ && xn + deq > start_ * scale_)
+        consistent_return(pr.values, xn, sp, deq);
       eq[p] = xn + deq;
       pr.compose(sp, tr);
       store_stress<D>(s, p, tr);
@@ -213,6 +237,7 @@ class StrainSofteningMC : public Material<D> {
   double E_, nu_, rho_;
   double c_[2], phi_[2], psi_[2];  // peak, residual
   double start_, end_, cutoff_;
+  double length_ = 0, scale_ = 1;  // characteristic_length (0: none), l_c / l_p
   double G_ = 0, lambda_ = 0, M_ = 0;
   bool constant_ = false;
   int eq_ = -1;

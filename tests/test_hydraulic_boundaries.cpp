@@ -252,6 +252,54 @@ TEST_CASE("hydraulic: prescribed pore pressure at the base drives steady upward 
   }
 }
 
+TEST_CASE("hydraulic: a prescribed pore pressure follows its time function",
+          "[two_phase][hydraulic][time_function]") {
+  // time_function f scales the pressure, p f(t), or the head, gamma_w (head f(t) - z):
+  //  - 10 kPa with f = 0.5 (constant) is the 5 kPa run, bitwise (10000 x 0.5 = 5000 exactly);
+  //  - the head 2 x 5000/9810 m with f = 0.5 is the head run of 5000/9810 m, bitwise;
+  //  - a ramp 0 -> 5 kPa over 0.3 s reaches the same steady seepage: base and mid particles
+  //    within 2 % of p = 5000 (1 - z / H) (the previous test's reference and tolerance), and
+  //    at t = 0.15 s the base particle's p is below the constant run's (the ramp is half way).
+  const double end = 2.5 / kCv;
+  const std::string fixed = "  - {type: fixed, face: x-}\n";
+  const double x = 0.0;
+  auto plain = run_column(
+      fixed + "  - {type: prescribed_pore_pressure, face: x-, pressure: 5000}\n", x, end);
+  auto half = run_column(fixed +
+                             "  - {type: prescribed_pore_pressure, face: x-, pressure: 10000, "
+                             "time_function: {type: constant, value: 0.5}}\n",
+                         x, end);
+  char head[256];
+  std::snprintf(head, sizeof head, "%.17g", 5000.0 / 9810.0);
+  char head2[256];
+  std::snprintf(head2, sizeof head2, "%.17g", 2 * (5000.0 / 9810.0));
+  auto hd = run_column(
+      fixed + "  - {type: prescribed_pore_pressure, face: x-, head: " + head + "}\n", x, end);
+  auto hd2 = run_column(fixed + "  - {type: prescribed_pore_pressure, face: x-, head: " + head2 +
+                            ", time_function: {type: constant, value: 0.5}}\n",
+                        x, end);
+  std::printf(
+      "prescribed pore pressure with f = 0.5: p %.17g (5 kPa run %.17g); head form %.17g "
+      "(%.17g)\n",
+      half.back().p, plain.back().p, hd2.back().p, hd.back().p);
+  CHECK(half.back().p == plain.back().p);
+  CHECK(half.back().sxx == plain.back().sxx);
+  CHECK(hd2.back().p == hd.back().p);
+  auto ramp = run_column(fixed +
+                             "  - {type: prescribed_pore_pressure, face: x-, pressure: 5000, "
+                             "time_function: {type: linear_ramp, duration: 0.3}}\n",
+                         x, end);
+  const Sample& a = ramp.back();
+  const double p_exact = 5000 * (1 - a.x);
+  const double early = at(ramp, 0.15).p, early_plain = at(plain, 0.15).p;
+  std::printf(
+      "ramped base pore pressure: at the end p = %.1f Pa (steady %.1f); at 0.15 s %.1f "
+      "Pa (constant 5 kPa: %.1f)\n",
+      a.p, p_exact, early, early_plain);
+  CHECK(a.p == Approx(p_exact).epsilon(0.02));
+  CHECK(early < 0.75 * early_plain);
+}
+
 TEST_CASE("hydraulic: conflicting or misplaced conditions are located errors",
           "[two_phase][hydraulic][cli]") {
   // Reference: README's error contract: FILE:LINE:COL: error: key.path: message, all at once,

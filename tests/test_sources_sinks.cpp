@@ -280,3 +280,28 @@ TEST_CASE("particles added by a source get every plugin's initial state", "[sour
               checked);
   CHECK(checked == 40);
 }
+
+TEST_CASE("an inflow's time function scales its velocity and the mass it creates", "[sources]") {
+  // The same 0.5 s window with the velocity ramped from 0 to 1 m/s over 0.4 s
+  // (linear_ramp): the layers advance by v int_0^0.5 f dt = 1 x (0.5 - 0.2) = 0.3 m, so the
+  // created mass is rho A (0.3 m) plus the fill (one layer), to one layer; the inlet particles
+  // move at v f(t).
+  TempDir dir("channel_ramp");
+  std::string yaml = channel("", "  - {type: plane, point: [0.6, 0], normal: [1, 0]}\n");
+  yaml = std::regex_replace(
+      yaml, std::regex("velocity: \\[1, 0\\]\\}"),
+      "velocity: [1, 0], end: 0.5, time_function: {type: linear_ramp, duration: 0.4}}");
+  auto r = run_text(dir.path, yaml);
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  std::ifstream js(dir.path / "out/summary.json");
+  const auto s = nlohmann::json::parse(js);
+  const double created = s["mass"]["created"], expected = kRho * kH * 0.3;
+  const double layer = kRho * kH * 0.01;
+  std::printf(
+      "ramped inflow, window 0.5 s: created %.5g kg/m, rho A v int f dt = %.5g (one "
+      "layer %.3g), balance %.3g\n",
+      created, expected, layer, s["mass"]["balance"].get<double>());
+  CHECK(std::fabs(created - expected) <= 1.5 * layer);
+  CHECK(std::fabs(s["mass"]["balance"].get<double>()) <= 1e-9 * created);
+}

@@ -384,3 +384,47 @@ TEST_CASE("strain_softening_mc: bad parameters give the located error", "[materi
   };
   loam_test::check_bad_material("type: strain_softening_mc, density: 2000, ", cases);
 }
+
+TEST_CASE("strain_softening_mc: characteristic_length scales the softening strains by l_c / l_p",
+          "[material][unit][regularisation]") {
+  // Regularisation (issue 16, deliverable 5): with characteristic_length l_c the softening
+  // strains apply to a band l_c wide and are scaled by l_c / l_p, l_p = V_p^(1/D) the body's
+  // particle size (here the one-point config's lattice: cell 0.25 m, 2 per cell, l_p = 0.125 m).
+  //  - l_c = l_p: scale 1, bitwise the unregularised response;
+  //  - l_c = 2 l_p: bitwise the response with softening_start and softening_end doubled
+  //    (0.01 -> 0.02, 0.05 -> 0.10: the products are exact in binary).
+  // Plane strain drained compression at 100 kPa to 15 % axial strain, 1500 increments.
+  auto run = [](const Soft& m) {
+    Point<2> pt(m.yaml());
+    return drained_compression(pt, m, 100e3, 0.15, 1500);
+  };
+  Soft plain;
+  Soft same = plain;
+  same.extra = ", characteristic_length: 0.125";
+  Soft twice = plain;
+  twice.extra = ", characteristic_length: 0.25";
+  Soft stretched = plain;
+  stretched.start = 0.02;
+  stretched.end = 0.10;
+  const auto a = run(plain), b = run(same), c = run(twice), d = run(stretched);
+  REQUIRE(a.size() == b.size());
+  REQUIRE(c.size() == d.size());
+  bool ab = true, cd = true, ac = true;
+  double eq_a = NAN, eq_c = NAN;  // the plastic strain where each first reaches residual
+  for (size_t i = 0; i < a.size(); ++i) {
+    ab = ab && a[i].sigma_1 == b[i].sigma_1 && a[i].eq == b[i].eq;
+    cd = cd && c[i].sigma_1 == d[i].sigma_1 && c[i].eq == d[i].eq;
+    ac = ac && a[i].sigma_1 == c[i].sigma_1;
+    if (std::isnan(eq_a) && a[i].eq >= plain.end) eq_a = a[i].eq;
+    if (std::isnan(eq_c) && c[i].eq >= stretched.end) eq_c = c[i].eq;
+  }
+  std::printf(
+      "characteristic_length: l_c = l_p bitwise the plain response: %s; l_c = 2 l_p "
+      "bitwise softening strains x 2: %s; residual reached at eq %.4f (plain) and %.4f "
+      "(l_c = 2 l_p)\n",
+      ab ? "yes" : "no", cd ? "yes" : "no", eq_a, eq_c);
+  CHECK(ab);
+  CHECK(cd);
+  CHECK_FALSE(ac);  // the scaling acts
+  CHECK(eq_c / eq_a == Approx(2).epsilon(0.05));
+}

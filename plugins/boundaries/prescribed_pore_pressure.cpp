@@ -7,9 +7,14 @@
 // nodal porosity n_I) takes -n_I p n_out A_I. They are nodal forces added before the scheme
 // solves the grid update (Boundary::add_forces), so the implicit drag couples them like every
 // other force; a skeleton fixed on the face then stays fixed, and the released water follows
-// the held skeleton through the drag (framework/hydraulic_face.hpp).
+// the held skeleton through the drag (framework/hydraulic_face.hpp). A `time_function` f(t) of
+// the loads' time scales the pressure, p f(t), or the head, gamma_w (head f(t) - z): a level
+// that rises, falls or follows a table of levels (head: 1 and the table in metres).
+#include <memory>
 #include "framework/hydraulic_face.hpp"
+
 #include "framework/registry.hpp"
+#include "framework/time_function.hpp"
 
 namespace loam {
 
@@ -29,32 +34,41 @@ class PrescribedPorePressure : public HydraulicFace<D> {
     s.real("unit_weight", "N/m^3", "unit weight of the water gamma_w, for head")
         .def("9810")
         .positive();
+    s.plugin("time_function", "time_function",
+             "factor f(t) of the loads' time on the pressure (p f) or on the head "
+             "(gamma_w (head f - z)); absent: 1");
     s.check([](const Params& p, Diagnostics& d) {
       if (p.has("pressure") == p.has("head"))
         d.error(p.where(), p.path(), "give exactly one of 'pressure' or 'head'");
     });
     return s;
   }
-  explicit PrescribedPorePressure(const Params& p) : HydraulicFace<D>(p) {}
+  explicit PrescribedPorePressure(const Params& p)
+      : HydraulicFace<D>(p),
+        head_(p.has("head")),
+        value_(p.has("head") ? p.real("head") : p.real("pressure")),
+        unit_weight_(p.real("unit_weight")) {
+    if (p.present("time_function"))
+      f_ = Registry::instance().create<TimeFunction, D>(p.section("time_function"));
+  }
   const char* condition() const override { return name; }
   int releases_face() const override { return face_index(this->face_); }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     HydraulicFace<D>::setup(sim, diag);
-    const Params& p = this->params_;
-    pressure_.assign(this->nodes_.size(), p.has("pressure") ? p.real("pressure") : 0.0);
-    if (p.has("head"))
-      for (size_t k = 0; k < this->nodes_.size(); ++k)
-        pressure_[k] =
-            p.real("unit_weight") * (p.real("head") - sim.grid.node_coord(this->nodes_[k], D - 1));
+    z_.resize(this->nodes_.size());
+    for (size_t k = 0; k < this->nodes_.size(); ++k)
+      z_[k] = sim.grid.node_coord(this->nodes_[k], D - 1);
   }
   void add_forces(const GridForces& f) const override {
     if (f.count < 2 || !f.porosity.base) return;
     const int a = this->face_.axis;
     const double out = this->face_.upper ? 1.0 : -1.0;
+    const double v = f_ ? value_ * f_->value(f.time) : value_;
     for (size_t k = 0; k < this->nodes_.size(); ++k) {
       const size_t n = this->nodes_[k];
-      const double traction = -pressure_[k] * out * this->area_[k];
+      const double p = head_ ? unit_weight_ * (v - z_[k]) : v;
+      const double traction = -p * out * this->area_[k];
       f.mixture.at(n, a) += traction;
       f.water.at(n, a) += f.porosity.at(n, 0) * traction;
     }
@@ -67,7 +81,11 @@ class PrescribedPorePressure : public HydraulicFace<D> {
   void constrain(const NodalVector& v) const override { this->release(v); }
 
  private:
-  std::vector<double> pressure_;  // per face node (Pa)
+  bool head_;
+  double value_;  // the pressure (Pa) or the head (m)
+  double unit_weight_;
+  std::unique_ptr<TimeFunction<D>> f_;
+  std::vector<double> z_;  // per face node, its vertical coordinate (m)
 };
 
 LOAM_REGISTER(Boundary, PrescribedPorePressure)

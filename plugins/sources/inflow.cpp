@@ -10,13 +10,18 @@
 // at the upstream side each time they have advanced one spacing s_a, exactly one spacing behind
 // the last one. The created mass rate is therefore rho v_a A (A the region's cross-section
 // normal to a). Particles of the body inside the region are given the velocity v each step, so
-// the inlet is a velocity inlet whatever the pressure downstream.
+// the inlet is a velocity inlet whatever the pressure downstream. A `time_function` f (of the
+// time since `start`, f >= 0) scales the velocity, v f(t); the layers then advance by
+// v_a times its integral (TimeFunction::integral, exact for piecewise-linear f), so a jet can
+// speed up, pulse or follow a table of velocities.
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "framework/boundary.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "framework/time_function.hpp"
 #include "plugins/sources/box_lattice.hpp"
 
 namespace loam {
@@ -44,6 +49,8 @@ class Inflow : public Source<D> {
         .required();
     s.real("start", "s", "time the inflow starts").def("0").min(0);
     s.real("end", "s", "time the inflow stops (default: never)").positive();
+    s.plugin("time_function", "time_function",
+             "factor f >= 0 on the velocity over the time since start (absent: 1)");
     s.check([](const Params& p, Diagnostics& d) {
       double v2 = 0;
       for (double v : p.vec("velocity")) v2 += v * v;
@@ -64,6 +71,8 @@ class Inflow : public Source<D> {
       v_[size_t(d)] = p.vec("velocity")[size_t(d)];
       if (std::fabs(v_[size_t(d)]) > std::fabs(v_[size_t(axis_)])) axis_ = d;
     }
+    if (p.present("time_function"))
+      f_ = Registry::instance().create<TimeFunction, D>(p.section("time_function"));
   }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
@@ -98,29 +107,32 @@ class Inflow : public Source<D> {
 
   void apply(Simulation<D>& sim, double t) override {
     if (body_ < 0 || t < start_ * (1 - 1e-12) || t >= end_) return;
-    prescribe_velocity(sim);
+    const Vec v = velocity(t);
+    prescribe_velocity(sim, v);
     const double va = std::fabs(v_[size_t(axis_)]), sa = s_[size_t(axis_)];
     if (!filled_) {  // the window opens: fill the region
       filled_ = true;
-      sim.add_particles(body_, sites_, v_);
+      sim.add_particles(body_, sites_, v);
       newest_time_ = t, newest_offset_ = 0;
       return;
     }
-    // The newest layer has moved newest_offset_ + v_a (t - newest_time_) from its site by now:
-    // one more layer per spacing, exactly one spacing behind the one before.
-    double a = newest_offset_ + va * (t - newest_time_);
+    // The newest layer has moved newest_offset_ + v_a int f dt since newest_time_ from its site
+    // by now: one more layer per spacing, exactly one spacing behind the one before.
+    const double travel = f_ ? f_->integral(newest_time_ - start_, t - start_) : t - newest_time_;
+    double a = newest_offset_ + va * travel;
     std::vector<Vec> x;
     while (a >= sa * (1 - 1e-9)) {
       a = std::max(a - sa, 0.0);
       for (const Vec& site : upstream_) x.push_back(add(site, a / va));
       newest_time_ = t, newest_offset_ = a;
     }
-    sim.add_particles(body_, x, v_);
+    sim.add_particles(body_, x, v);
   }
 
  private:
   Params params_;
   double start_, end_;
+  std::unique_ptr<TimeFunction<D>> f_;
   Vec lo_{}, hi_{}, v_{}, s_{};
   int axis_ = 0, body_ = -1;
   bool filled_ = false;
@@ -152,8 +164,16 @@ class Inflow : public Source<D> {
     box_lattice<D>(sim.grid, lo_, hi_, s_, axis_, v_[size_t(axis_)] < 0, sites_, upstream_);
   }
 
+  /// v f(t - start), or v without a time function.
+  Vec velocity(double t) const {
+    if (!f_) return v_;
+    Vec v = v_;
+    for (auto& c : v) c *= f_->value(t - start_);
+    return v;
+  }
+
   /// The body's particles inside the region move at v (a velocity inlet).
-  void prescribe_velocity(Simulation<D>& sim) const {
+  void prescribe_velocity(Simulation<D>& sim, const Vec& v) const {
     Particles<D>& P = sim.particles_of_body(body_);
     for (size_t i = 0; i < P.size(); ++i) {
       if (P.body[i] != body_) continue;
@@ -163,7 +183,7 @@ class Inflow : public Source<D> {
         in = in && x >= lo_[size_t(d)] && x <= hi_[size_t(d)];
       }
       if (in)
-        for (int d = 0; d < D; ++d) P.col(P.velocity, d)[i] = v_[size_t(d)];
+        for (int d = 0; d < D; ++d) P.col(P.velocity, d)[i] = v[size_t(d)];
     }
   }
 

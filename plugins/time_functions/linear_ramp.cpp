@@ -29,6 +29,10 @@ class LinearRamp : public TimeFunction<D> {
     const double s = std::clamp((t - start_) / duration_, 0.0, 1.0);
     return from_ + (to_ - from_) * s;
   }
+  void kinks(double t0, double t1, std::vector<double>& out) const override {
+    for (double k : {start_, start_ + duration_})
+      if (k > t0 && k < t1) out.push_back(k);
+  }
 
  private:
   double duration_, start_, from_, to_;

@@ -27,6 +27,10 @@ class SineTime : public TimeFunction<D> {
   double value(double t) const override {
     return offset_ + amplitude_ * std::sin(omega_ * t + phase_);
   }
+  double integral(double t0, double t1) const override {
+    return offset_ * (t1 - t0) -
+           amplitude_ / omega_ * (std::cos(omega_ * t1 + phase_) - std::cos(omega_ * t0 + phase_));
+  }
 
  private:
   double amplitude_, omega_, phase_, offset_;

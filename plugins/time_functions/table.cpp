@@ -41,6 +41,10 @@ class TableTime : public TimeFunction<D> {
     const double s = (t - t_[k - 1]) / (t_[k] - t_[k - 1]);
     return v_[k - 1] + s * (v_[k] - v_[k - 1]);
   }
+  void kinks(double t0, double t1, std::vector<double>& out) const override {
+    for (auto it = std::upper_bound(t_.begin(), t_.end(), t0); it != t_.end() && *it < t1; ++it)
+      out.push_back(*it);
+  }
 
  private:
   /// The points from the inline lists or the file; with `diag`, every problem as a located

@@ -35,6 +35,10 @@ class TriangularPulse : public TimeFunction<D> {
     return peak_ * (t <= peak_time_ ? (t - start_) / (peak_time_ - start_)
                                     : (end_ - t) / (end_ - peak_time_));
   }
+  void kinks(double t0, double t1, std::vector<double>& out) const override {
+    for (double k : {start_, peak_time_, end_})
+      if (k > t0 && k < t1) out.push_back(k);
+  }
 
  private:
   double start_, peak_time_, end_, peak_;
