@@ -113,6 +113,39 @@ std::vector<size_t> box_nodes(const Grid<D>& g, const Params& p, Diagnostics& di
   return out;
 }
 
+template <int D>
+void face_or_box_components(const Grid<D>& grid, const Params& p, const Face& face, bool box,
+                            std::vector<size_t>& nodes, std::vector<int>& components,
+                            Diagnostics& d) {
+  if (box)
+    nodes = box_nodes(grid, p, d);
+  else if (!check_face(face, D, p, "face", d))
+    return;
+  else
+    nodes = face_nodes(grid, face);
+  if (!p.has("directions")) {
+    components.push_back(face.axis);
+    return;
+  }
+  for (const auto& c : p.strings("directions")) {
+    const int axis = c.size() == 1 ? c[0] - 'x' : -1;
+    if (axis < 0 || axis >= D)
+      d.error(p.where("directions"), p.path("directions"),
+              "unknown direction '" + c + "' (use x" + (D > 1 ? ", y" : "") + (D > 2 ? ", z" : "") +
+                  ")");
+    else
+      components.push_back(axis);
+  }
+}
+
+#define LOAM_FACE_OR_BOX(D)                                                                 \
+  template void face_or_box_components<D>(const Grid<D>&, const Params&, const Face&, bool, \
+                                          std::vector<size_t>&, std::vector<int>&, Diagnostics&);
+LOAM_FACE_OR_BOX(1)
+LOAM_FACE_OR_BOX(2)
+LOAM_FACE_OR_BOX(3)
+#undef LOAM_FACE_OR_BOX
+
 template std::vector<size_t> box_nodes<1>(const Grid<1>&, const Params&, Diagnostics&);
 template std::vector<size_t> box_nodes<2>(const Grid<2>&, const Params&, Diagnostics&);
 template std::vector<size_t> box_nodes<3>(const Grid<3>&, const Params&, Diagnostics&);

@@ -72,6 +72,8 @@ struct GridUpdate {
   /// The components held per phase, set by Simulation::constrain_update (schemes leave them
   /// null; a condition driven alone, e.g. by a unit test, must accept null).
   std::array<HeldComponents*, 2> held{};
+  /// The loads' time (since the stage that set the running loads began), for time functions.
+  double time = 0;
 };
 
 /// The nodal forces of a grid step before the scheme integrates them. mixture: the force of the
@@ -250,5 +252,13 @@ void add_face_or_box_params(Schema& s, bool face_required_otherwise);
 /// The nodes inside [min, max] of p (to 1e-9 of a cell); a located error if there is none.
 template <int D>
 std::vector<size_t> box_nodes(const Grid<D>& grid, const Params& p, Diagnostics& d);
+
+/// The nodes of a face-or-box condition (a box: box_nodes; a face: face_nodes, after
+/// check_face) and the components it acts on: those named in `directions` (x, y, z), or the
+/// face normal without it. Unknown names are located errors. (slip, prescribed_velocity)
+template <int D>
+void face_or_box_components(const Grid<D>& grid, const Params& p, const Face& face, bool box,
+                            std::vector<size_t>& nodes, std::vector<int>& components,
+                            Diagnostics& d);
 
 }  // namespace loam

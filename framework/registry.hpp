@@ -26,7 +26,8 @@ namespace loam {
 /// 2: Boundary::constrain_grid_update (all phases of a grid update, with nodal masses).
 /// 3: Boundary::mark_held, coulomb_update and add_forces, GridUpdate::held (the passes of the
 ///    grid update), Scheme::add_energies.
-/// 5: Boundary::save_state/restore_state (checkpointed conditions), GridForces::time.
+/// 5: Boundary::save_state/restore_state (checkpointed conditions), GridForces::time and
+///    GridUpdate::time.
 constexpr int kPluginAbiVersion = 5;
 
 struct PluginInfo {

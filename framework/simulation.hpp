@@ -136,6 +136,7 @@ class Simulation {
   ///  4. the hydraulic conditions on the water.
   void constrain_update(const GridUpdate& update) {
     GridUpdate u = update;
+    u.time = time - loads_start;
     for (int k = 0; k < u.count; ++k) {
       held_[size_t(k)].clear(grid.num_nodes);
       u.held[size_t(k)] = &held_[size_t(k)];

@@ -133,7 +133,7 @@ TEST_CASE("cavity_pressure: a pressurised hole in an elastic plate gives Lame's 
   // below 6 % of p and the lattice's staircase outer surface weighs in).
   const double p = 1.0e4, a = 1, b = 6;
   for (const char* shape : {"gimp", "bspline2"}) {
-    auto sim = loam_test::make_simulation<2>(quarter_annulus(shape, 0.125, p), 2);
+    auto sim = loam_test::make_simulation<2>(quarter_annulus(shape, 0.125, p));
     while (sim->time < 3) REQUIRE(sim->advance(sim->stable_dt()));
     const auto& P = sim->sets[0].particles;
     const double edges[] = {2, 2.5, 3, 3.5, 4};

@@ -39,25 +39,7 @@ class Slip : public Boundary<D> {
   bool applies_to(int phase) const override { return (phases_ >> phase) & 1; }
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     check_phase_mask(phases_, sim.scheme->phases(), params_, diag);
-    if (box_)
-      nodes_ = box_nodes(sim.grid, params_, diag);
-    else if (!check_face(face_, D, params_, "face", diag))
-      return;
-    else
-      nodes_ = face_nodes(sim.grid, face_);
-    if (!params_.has("directions")) {
-      fixed_.push_back(face_.axis);
-      return;
-    }
-    for (const auto& c : params_.strings("directions")) {
-      int axis = c.size() == 1 ? c[0] - 'x' : -1;
-      if (axis < 0 || axis >= D)
-        diag.error(params_.where("directions"), params_.path("directions"),
-                   "unknown direction '" + c + "' (use x" + (D > 1 ? ", y" : "") +
-                       (D > 2 ? ", z" : "") + ")");
-      else
-        fixed_.push_back(axis);
-    }
+    face_or_box_components(sim.grid, params_, face_, box_, nodes_, fixed_, diag);
   }
   void constrain(const NodalVector& v) const override {
     for (size_t n : nodes_)
