@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 #include "cli.hpp"
 #include "plugins/references/sheet_pile.hpp"
@@ -44,7 +45,10 @@ TEST_CASE("reservoir: a rising level adds layers at level + level_rate t until t
   // 0.5 + 1.0 t, capped at the box's top (1.5 m). Water alone (double-point scheme) in a slip
   // box under gravity; the top point must stay within one spacing (0.05 m) plus the water's
   // compression of level(t) while it rises, then at the top; the mass balance is round-off.
-  const std::string yaml = R"(
+  // With a time function on the speed (a table: 1 until 0.4 s, down to 0 at 0.6 s, then 0)
+  // the level is 0.5 + int_0^t f dt: 0.5 + t to 0.4 s, then it stops at 1.0 m.
+  auto yaml = [](const std::string& timing) {
+    return R"(
 grid: {origin: [0, 0], extent: [1, 2], cell_size: 0.1}
 gravity: [0, -9.81]
 scheme: {type: two_phase_double_point, porosity: 0.4, drag: {type: darcy, hydraulic_conductivity: 1.0e-3}}
@@ -57,28 +61,47 @@ boundaries:
   - {type: slip, face: x-}
   - {type: slip, face: x+}
 sources:
-  - {type: reservoir, body: pool, min: [0, 0], max: [1, 1.5], refill: y+, level: 0.5, level_rate: 1.0}
+  - {type: reservoir, body: pool, min: [0, 0], max: [1, 1.5], refill: y+, level: 0.5, level_rate: 1.0)" +
+           timing + R"(}
 time: {end: 2}
 )";
-  auto sim = loam_test::make_simulation<2>(yaml);
-  const auto& P = sim->sets[1].particles;
-  auto top = [&] {
-    double t = 0;
-    for (size_t i = 0; i < P.size(); ++i) t = std::max(t, P.col(P.position, 1)[i]);
-    return t;
   };
-  for (double t_check : {0.3, 0.6, 0.9, 1.3}) {
-    while (sim->time < t_check) loam_test::advance(*sim, 1);
-    const double level = std::min(0.5 + sim->time, 1.5), z = top();
-    std::printf("reservoir at t = %.3f s: level %.3f m, top point %.4f m\n", sim->time, level, z);
-    CHECK(z <= level + 1e-9);
-    CHECK(z >= level - 0.05 - 0.02);  // one spacing, plus the column's compression (< 2 cm)
+  auto steady = [](double t) { return std::min(0.5 + t, 1.5); };
+  auto table = [](double t) {
+    if (t <= 0.4) return 0.5 + t;
+    const double u = std::min(t, 0.6) - 0.4;  // f = 1 - u / 0.2 on [0.4, 0.6]
+    return 0.9 + u - u * u / 0.4;
+  };
+  struct Case {
+    std::string timing;
+    std::function<double(double)> level;
+    double created_min;
+  };
+  const std::vector<Case> cases = {
+      {"", steady, 900},  // about 1 m of water, 1 m wide
+      {", time_function: {type: table, times: [0, 0.4, 0.6], values: [1, 1, 0]}", table, 400}};
+  for (const auto& c : cases) {
+    auto sim = loam_test::make_simulation<2>(yaml(c.timing));
+    const auto& P = sim->sets[1].particles;
+    auto top = [&] {
+      double t = 0;
+      for (size_t i = 0; i < P.size(); ++i) t = std::max(t, P.col(P.position, 1)[i]);
+      return t;
+    };
+    for (double t_check : {0.3, 0.6, 0.9, 1.3}) {
+      while (sim->time < t_check) loam_test::advance(*sim, 1);
+      const double level = c.level(sim->time), z = top();
+      std::printf("reservoir%s at t = %.3f s: level %.3f m, top point %.4f m\n",
+                  c.timing.empty() ? "" : " (time function)", sim->time, level, z);
+      CHECK(z <= level + 1e-9);
+      CHECK(z >= level - 0.05 - 0.02);  // one spacing, plus the column's compression (< 2 cm)
+    }
+    const double balance =
+        sim->total_mass() + sim->mass_removed - sim->mass_created - sim->initial_mass;
+    std::printf("reservoir: created %.2f kg/m, balance %.1e\n", sim->mass_created, balance);
+    CHECK(sim->mass_created > c.created_min);
+    CHECK(std::fabs(balance) <= 1e-9 * sim->total_mass());
   }
-  const double balance =
-      sim->total_mass() + sim->mass_removed - sim->mass_created - sim->initial_mass;
-  std::printf("reservoir: created %.2f kg/m, balance %.1e\n", sim->mass_created, balance);
-  CHECK(sim->mass_created > 900);  // about 1 m of water, 1 m wide
-  CHECK(std::fabs(balance) <= 1e-9 * sim->total_mass());
 }
 
 TEST_CASE("slip box: the water flows along a smooth pile and a fixed box stops it there",

@@ -228,6 +228,15 @@ TEST_CASE("sources and sinks: located errors for bad input, exit 2, nothing writ
        with("sources:",
             "loads:\n  - {type: traction, body: water, face: y+, traction: [0, 1]}\nsources:"),
        "error: loads.0.body: body 'water' has no particles at t = 0 (no generator)"},
+      {"a reservoir's time function without a level rate",
+       with(inflow,
+            "{type: reservoir, body: water, min: [0, 0], max: [0.2, 0.2], refill: x-, "
+            "time_function: {type: constant, value: 2}}"),
+       "error: sources.0.time_function: the time function scales level_rate: give a "
+       "level_rate > 0"},
+      {"an unknown time function of an inflow",
+       with("velocity: [1, 0]}", "velocity: [1, 0], time_function: {type: ramp}}"),
+       "unknown time_function 'ramp'"},
   };
   for (const auto& c : cases) {
     TempDir dir("sources_bad");

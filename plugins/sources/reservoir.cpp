@@ -14,15 +14,19 @@
 // A rising pool (the upstream side of a sheet pile raised slowly, seed 000): `level` puts the
 // refill face inside the box at t = 0 and `level_rate` moves it outward along its axis at a
 // constant speed, level(t) = level + level_rate t, until it reaches the box's own face, where
-// it stays. The face layer is then the last lattice site at or inside level(t). (A general
-// time function for sources is issue 16; this is its constant-rate case.)
+// it stays. The face layer is then the last lattice site at or inside level(t). A
+// `time_function` f >= 0 of the run's time scales the speed: level(t) = level + level_rate
+// int_0^t f dt (TimeFunction::integral: exact for piecewise-linear f), a level that rises in
+// steps, pauses or follows a table of speeds.
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "framework/boundary.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "framework/time_function.hpp"
 #include "plugins/sources/box_lattice.hpp"
 
 namespace loam {
@@ -53,11 +57,20 @@ class Reservoir : public Source<D> {
            "box's face")
         .def("0")
         .non_negative();
-    s.check([](const Params& p, Diagnostics& d) { check_box_corners(p, d); });
+    s.plugin("time_function", "time_function",
+             "factor f >= 0 on level_rate over the run's time (absent: 1)");
+    s.check([](const Params& p, Diagnostics& d) {
+      check_box_corners(p, d);
+      if (p.present("time_function") && !(p.real("level_rate") > 0))
+        d.error(p.where("time_function"), p.path("time_function"),
+                "the time function scales level_rate: give a level_rate > 0");
+    });
     return s;
   }
   explicit Reservoir(const Params& p)
       : params_(p), refill_(parse_face(p.text("refill"))), rate_(p.real("level_rate")) {
+    if (p.present("time_function"))
+      f_ = Registry::instance().create<TimeFunction, D>(p.section("time_function"));
     for (int d = 0; d < D; ++d) {
       lo_[size_t(d)] = p.vec("min")[size_t(d)];
       hi_[size_t(d)] = p.vec("max")[size_t(d)];
@@ -148,7 +161,8 @@ class Reservoir : public Source<D> {
   /// level(t) = level + level_rate t (outward), never beyond the box's own end layer.
   double face_site(double t) const {
     const int a = refill_.axis;
-    const double sa = s_[size_t(a)], level = level0_ + sign() * rate_ * t;
+    const double travel = f_ ? f_->integral(0, t) : t;
+    const double sa = s_[size_t(a)], level = level0_ + sign() * rate_ * travel;
     const double k = (level - origin_) / sa - 0.5, end = layer_[0][size_t(a)];
     const double y =
         origin_ + ((refill_.upper ? std::floor(k + 1e-9) : std::ceil(k - 1e-9)) + 0.5) * sa;
@@ -165,7 +179,8 @@ class Reservoir : public Source<D> {
   Params params_;
   Face refill_;
   Vec lo_{}, hi_{}, s_{};
-  double rate_ = 0, level0_ = 0, origin_ = 0;  // origin_: the grid origin along the axis
+  double rate_ = 0, level0_ = 0, origin_ = 0;
+  std::unique_ptr<TimeFunction<D>> f_;  // origin_: the grid origin along the axis
   int body_ = -1;
   std::vector<Vec> sites_, layer_;  // every lattice site of the box; those of the refill layer
 };
