@@ -29,11 +29,10 @@ class Generator {
   };
   /// The region's surface as quadrature points about `spacing` apart whose areas sum to the
   /// surface's (exactly, up to round-off), for a load on the wall of a cavity (cavity_pressure).
-  /// Only regions that describe their surface (describes_surface) give any; a cylinder gives its
+  /// Empty for a region that does not describe its surface (default); a cylinder gives its
   /// wall, not its ends. Samples are symmetric about the coordinate planes through the region's
   /// centre, so a quarter of them covers a quarter model's wall exactly.
   virtual std::vector<SurfaceSample> surface_samples(double /*spacing*/) const { return {}; }
-  virtual bool describes_surface() const { return false; }
 };
 
 }  // namespace loam

@@ -27,19 +27,37 @@ inline void add_load_time_keys(Schema& s) {
   });
 }
 
+/// A plugin's optional `time_function`, its clock starting at `start`: value(t) = f(t - start),
+/// integral(t0, t1) = the integral of f(t - start) over [t0, t1]; without one 1 and t1 - t0
+/// (loads, sources, prescribed boundary values).
+template <int D>
+class TimeFactor {
+ public:
+  explicit TimeFactor(const Params& p, double start = 0) : start_(start) {
+    if (p.present("time_function"))
+      f_ = Registry::instance().create<TimeFunction, D>(p.section("time_function"));
+  }
+  bool present() const { return f_ != nullptr; }
+  double value(double t) const { return f_ ? f_->value(t - start_) : 1.0; }
+  double integral(double t0, double t1) const {
+    return f_ ? f_->integral(t0 - start_, t1 - start_) : t1 - t0;
+  }
+
+ private:
+  double start_;
+  std::unique_ptr<TimeFunction<D>> f_;
+};
+
 /// f(t) of a load: its time function, else the ramp (1 after ramp_time; 1 throughout for 0).
 template <int D>
 class LoadTime {
  public:
-  explicit LoadTime(const Params& p) : ramp_(p.real("ramp_time")) {
-    if (p.present("time_function"))
-      f_ = Registry::instance().create<TimeFunction, D>(p.section("time_function"));
-  }
-  double operator()(double t) const { return f_ ? f_->value(t) : ramp_factor(t, ramp_); }
+  explicit LoadTime(const Params& p) : ramp_(p.real("ramp_time")), f_(p) {}
+  double operator()(double t) const { return f_.present() ? f_.value(t) : ramp_factor(t, ramp_); }
 
  private:
   double ramp_;
-  std::unique_ptr<TimeFunction<D>> f_;
+  TimeFactor<D> f_;
 };
 
 }  // namespace loam

@@ -153,8 +153,6 @@ class StrainSofteningMC : public Material<D> {
       scale_ = length_ / std::pow(volume, 1.0 / D);
     }
   }
-  /// The softening strains' scale l_c / l_p (1 without characteristic_length).
-  double softening_scale() const { return scale_; }
 
   double wave_speed(const Particles<D>& P, size_t b, size_t e) const override {
     return p_wave_speed(P, b, e, M_);  // elastic P-wave speed bounds the plastic one

@@ -13,8 +13,8 @@
 #include <memory>
 #include "framework/hydraulic_face.hpp"
 
+#include "framework/load_time.hpp"
 #include "framework/registry.hpp"
-#include "framework/time_function.hpp"
 
 namespace loam {
 
@@ -47,10 +47,8 @@ class PrescribedPorePressure : public HydraulicFace<D> {
       : HydraulicFace<D>(p),
         head_(p.has("head")),
         value_(p.has("head") ? p.real("head") : p.real("pressure")),
-        unit_weight_(p.real("unit_weight")) {
-    if (p.present("time_function"))
-      f_ = Registry::instance().create<TimeFunction, D>(p.section("time_function"));
-  }
+        unit_weight_(p.real("unit_weight")),
+        f_(p) {}
   const char* condition() const override { return name; }
   int releases_face() const override { return face_index(this->face_); }
 
@@ -64,7 +62,7 @@ class PrescribedPorePressure : public HydraulicFace<D> {
     if (f.count < 2 || !f.porosity.base) return;
     const int a = this->face_.axis;
     const double out = this->face_.upper ? 1.0 : -1.0;
-    const double v = f_ ? value_ * f_->value(f.time) : value_;
+    const double v = value_ * f_.value(f.time);
     for (size_t k = 0; k < this->nodes_.size(); ++k) {
       const size_t n = this->nodes_[k];
       const double p = head_ ? unit_weight_ * (v - z_[k]) : v;
@@ -84,7 +82,7 @@ class PrescribedPorePressure : public HydraulicFace<D> {
   bool head_;
   double value_;  // the pressure (Pa) or the head (m)
   double unit_weight_;
-  std::unique_ptr<TimeFunction<D>> f_;
+  TimeFactor<D> f_;
   std::vector<double> z_;  // per face node, its vertical coordinate (m)
 };
 

@@ -12,9 +12,9 @@
 #include <algorithm>
 #include <memory>
 
+#include "framework/load_time.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
-#include "framework/time_function.hpp"
 
 namespace loam {
 
@@ -45,10 +45,9 @@ class PrescribedVelocity : public Boundary<D> {
       : params_(p),
         face_(parse_face(p.has("face") ? p.text("face") : "x-")),
         box_(!p.has("face")),
-        phases_(parse_phase_mask(p)) {
+        phases_(parse_phase_mask(p)),
+        f_(p) {
     for (int d = 0; d < D; ++d) v_[size_t(d)] = p.vec("velocity")[size_t(d)];
-    if (p.present("time_function"))
-      f_ = Registry::instance().create<TimeFunction, D>(p.section("time_function"));
   }
   bool applies_to(int phase) const override { return (phases_ >> phase) & 1; }
 
@@ -59,7 +58,7 @@ class PrescribedVelocity : public Boundary<D> {
 
   /// The velocity of this step (kept for the MUSL re-map of the same step).
   void constrain_grid_update(const GridUpdate& u) const override {
-    const double f = f_ ? f_->value(u.time) : 1.0;
+    const double f = f_.value(u.time);
     for (int d = 0; d < D; ++d) now_[size_t(d)] = v_[size_t(d)] * f;
     for (int k = 0; k < u.count; ++k) {
       if (!applies_to(k)) continue;
@@ -91,7 +90,7 @@ class PrescribedVelocity : public Boundary<D> {
   bool box_;
   int phases_;
   std::array<double, D> v_{};
-  std::unique_ptr<TimeFunction<D>> f_;
+  TimeFactor<D> f_;
   std::vector<size_t> nodes_;
   std::vector<int> dirs_;
   mutable std::array<double, D> now_{};  // velocity of the current step

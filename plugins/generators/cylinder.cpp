@@ -50,12 +50,11 @@ class Cylinder : public Generator<D> {
   }
   bool contains(const std::array<double, D>& x) const override {
     if (D == 3 && (x[size_t(axis_)] < from_ || x[size_t(axis_)] > to_)) return false;
-    return radial(x).second <= r_;
+    return distance_from_axis(x) <= r_;
   }
   std::array<double, D> lower() const override { return bound(-1); }
   std::array<double, D> upper() const override { return bound(+1); }
 
-  bool describes_surface() const override { return true; }
   /// The wall: circle_rule about the axis, times a midpoint rule along it in 3D.
   std::vector<typename Generator<D>::SurfaceSample> surface_samples(double spacing) const override {
     std::vector<typename Generator<D>::SurfaceSample> out;
@@ -76,16 +75,11 @@ class Cylinder : public Generator<D> {
   }
 
  private:
-  /// The part of x - centre normal to the axis, and its length.
-  std::pair<std::array<double, D>, double> radial(const std::array<double, D>& x) const {
-    std::array<double, D> v{};
+  double distance_from_axis(const std::array<double, D>& x) const {
     double r2 = 0;
-    for (int d = 0; d < D; ++d) {
-      if (d == axis_) continue;
-      v[size_t(d)] = x[size_t(d)] - c_[size_t(d)];
-      r2 += v[size_t(d)] * v[size_t(d)];
-    }
-    return {v, std::sqrt(r2)};
+    for (int d = 0; d < D; ++d)
+      if (d != axis_) r2 += (x[size_t(d)] - c_[size_t(d)]) * (x[size_t(d)] - c_[size_t(d)]);
+    return std::sqrt(r2);
   }
   std::array<double, D> bound(int side) const {
     std::array<double, D> b{};

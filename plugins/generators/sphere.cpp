@@ -38,7 +38,6 @@ class Sphere : public Generator<D> {
     for (auto& v : b) v += r_;
     return b;
   }
-  bool describes_surface() const override { return true; }
   std::vector<typename Generator<D>::SurfaceSample> surface_samples(double spacing) const override {
     std::vector<typename Generator<D>::SurfaceSample> out;
     auto add = [&](const std::array<double, 3>& n, double area) {

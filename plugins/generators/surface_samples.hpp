@@ -5,9 +5,34 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <vector>
 
+#include "framework/diagnostics.hpp"
+#include "framework/generator.hpp"
+#include "framework/params.hpp"
+
 namespace loam {
+
+/// The wall of the cavity given under `key` of p (cavity_pressure, blast_wave), sampled about
+/// `spacing` apart (Generator::surface_samples), or a located error, and empty, when the region
+/// has a problem or does not describe its surface.
+template <int D>
+std::vector<typename Generator<D>::SurfaceSample> cavity_wall(const Generator<D>& cavity,
+                                                              const Params& p,
+                                                              const std::string& key,
+                                                              double spacing, Diagnostics& diag) {
+  if (std::string problem = cavity.check(); !problem.empty()) {
+    diag.error(p.where(key), p.path(key), problem);
+    return {};
+  }
+  auto wall = cavity.surface_samples(spacing);
+  if (wall.empty())
+    diag.error(p.where(key), p.path(key),
+               "a '" + p.section(key).type() +
+                   "' region does not describe its surface; a cavity is a sphere or a cylinder");
+  return wall;
+}
 
 /// Points on a circle of radius r about the origin in the plane (cos t, sin t): angles, and the
 /// arc each stands for, with about `spacing` between neighbours.

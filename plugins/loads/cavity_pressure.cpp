@@ -19,6 +19,7 @@
 #include "framework/load_time.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "plugins/generators/surface_samples.hpp"
 
 namespace loam {
 
@@ -49,20 +50,13 @@ class CavityPressure : public Load<D> {
   bool uses_particle_forces() const override { return true; }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
-    if (std::string problem = cavity_->check(); !problem.empty()) {
-      diag.error(params_.where("cavity"), params_.path("cavity"), problem);
-      return;
-    }
-    if (!cavity_->describes_surface()) {
-      diag.error(params_.where("cavity"), params_.path("cavity"),
-                 "a '" + params_.section("cavity").type() +
-                     "' region does not describe its surface; a cavity is a sphere or a "
-                     "cylinder");
-      return;
-    }
     const int b = sim.body_param(params_, "body", diag);
     if (b < 0) return;
     const Body& body = sim.bodies[size_t(b)];
+    double s = 0;  // the body's largest particle spacing
+    for (double h : body.spacing) s = std::max(s, h);
+    const auto wall = cavity_wall(*cavity_, params_, "cavity", s / 4, diag);
+    if (wall.empty()) return;
     if (!body.params.has("generator")) {
       diag.error(params_.where("body"), params_.path("body"),
                  "body '" + body.name + "' starts empty (no generator): it has no cavity wall");
@@ -77,9 +71,7 @@ class CavityPressure : public Load<D> {
                      "`difference` generator)");
       return;
     }
-    double s = 0;  // the body's largest particle spacing
-    for (double h : body.spacing) s = std::max(s, h);
-    assign_samples(sim, b, *region, s);
+    assign_samples(sim, b, *region, wall, s);
     if (ids_.empty())
       diag.error(params_.where("cavity"), params_.path("cavity"),
                  "no particle of body '" + body.name +
@@ -95,10 +87,6 @@ class CavityPressure : public Load<D> {
       for (int d = 0; d < D; ++d) P.col(sim.external_force, d)[i] += p * area_vector_[k][size_t(d)];
     }
   }
-
-  /// The loaded particles' ids and their area vectors A_p n_p (for tests and references).
-  const std::vector<uint32_t>& ids() const { return ids_; }
-  const std::vector<std::array<double, D>>& area_vectors() const { return area_vector_; }
 
  private:
   using Cell = std::array<long, D>;
@@ -122,7 +110,8 @@ class CavityPressure : public Load<D> {
 
   /// Each wall sample's area vector A_q n_q to the nearest body particle (within 2 s), found
   /// through a hash of the particles near the cavity by cells of size s.
-  void assign_samples(const Simulation<D>& sim, int b, const Generator<D>& region, double s) {
+  void assign_samples(const Simulation<D>& sim, int b, const Generator<D>& region,
+                      const std::vector<typename Generator<D>::SurfaceSample>& wall, double s) {
     const auto& P = sim.sets[size_t(set_)].particles;
     const auto lo = cavity_->lower(), hi = cavity_->upper();
     std::map<Cell, std::vector<size_t>> near;
@@ -138,7 +127,7 @@ class CavityPressure : public Load<D> {
       if (close) near[cell_of(x, s)].push_back(i);
     }
     std::map<size_t, std::array<double, D>> share;  // particle index -> sum A_q n_q
-    for (const auto& q : cavity_->surface_samples(s / 4)) {
+    for (const auto& q : wall) {
       std::array<double, D> outside{};
       for (int d = 0; d < D; ++d)
         outside[size_t(d)] = q.x[size_t(d)] + 0.5 * s * q.normal[size_t(d)];

@@ -31,6 +31,7 @@
 
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "plugins/generators/surface_samples.hpp"
 
 namespace loam {
 
@@ -72,16 +73,8 @@ class BlastWave : public Reference<D> {
     body_ = sim.body_param(params_, "body", diag);
     if (params_.has("cover")) cover_ = sim.body_param(params_, "cover", diag);
     if (body_ < 0 || (params_.has("cover") && cover_ < 0)) return;
-    if (std::string problem = cavity_->check(); !problem.empty()) {
-      diag.error(params_.where("cavity"), params_.path("cavity"), problem);
-      return;
-    }
-    wall_ = cavity_->surface_samples(0.5 * sim.grid.cell[0]);
-    if (wall_.empty()) {
-      diag.error(params_.where("cavity"), params_.path("cavity"),
-                 "the cavity must be a sphere or a cylinder (a region that describes its wall)");
-      return;
-    }
+    wall_ = cavity_wall(*cavity_, params_, "cavity", 0.5 * sim.grid.cell[0], diag);
+    if (wall_.empty()) return;
     c1_ = p_wave_speed(sim, body_);
     c2_ = cover_ >= 0 ? p_wave_speed(sim, cover_) : c1_;
     const auto& list = params_.list("probes");
@@ -98,6 +91,7 @@ class BlastWave : public Reference<D> {
         continue;
       }
       pr.expected = travel_time(pr.x0, pr.body == cover_);
+      pr.eq = sim.sets[size_t(pr.set)].particles.find(plastic_strain_eq_field().name);
       probes_.push_back(pr);
     }
   }
@@ -118,8 +112,7 @@ class BlastWave : public Reference<D> {
       pr.displacement.push_back(std::sqrt(u2));
       pr.p.push_back(p);
       pr.q.push_back(q);
-      const int eq = P.find(plastic_strain_eq_field().name);
-      pr.plastic = eq >= 0 ? P.col(eq)[i] : 0.0;
+      pr.plastic = pr.eq >= 0 ? P.col(pr.eq)[i] : 0.0;
       if (time_.size() == 1) pr.plastic0 = pr.plastic;
     }
   }
@@ -193,7 +186,7 @@ class BlastWave : public Reference<D> {
  private:
   struct Probe {
     std::string name;
-    int set = 0, body = -1;
+    int set = 0, body = -1, eq = -1;  // eq: its plastic_strain_eq field, if any
     uint32_t id = 0;
     std::array<double, D> x0{};
     double expected = 0, plastic = 0, plastic0 = 0;

@@ -19,9 +19,9 @@
 #include <memory>
 
 #include "framework/boundary.hpp"
+#include "framework/load_time.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
-#include "framework/time_function.hpp"
 #include "plugins/sources/box_lattice.hpp"
 
 namespace loam {
@@ -64,15 +64,14 @@ class Inflow : public Source<D> {
   explicit Inflow(const Params& p)
       : params_(p),
         start_(p.real("start")),
-        end_(p.has("end") ? p.real("end") : std::numeric_limits<double>::infinity()) {
+        end_(p.has("end") ? p.real("end") : std::numeric_limits<double>::infinity()),
+        f_(p, start_) {
     for (int d = 0; d < D; ++d) {
       lo_[size_t(d)] = p.vec("min")[size_t(d)];
       hi_[size_t(d)] = p.vec("max")[size_t(d)];
       v_[size_t(d)] = p.vec("velocity")[size_t(d)];
       if (std::fabs(v_[size_t(d)]) > std::fabs(v_[size_t(axis_)])) axis_ = d;
     }
-    if (p.present("time_function"))
-      f_ = Registry::instance().create<TimeFunction, D>(p.section("time_function"));
   }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
@@ -118,8 +117,7 @@ class Inflow : public Source<D> {
     }
     // The newest layer has moved newest_offset_ + v_a int f dt since newest_time_ from its site
     // by now: one more layer per spacing, exactly one spacing behind the one before.
-    const double travel = f_ ? f_->integral(newest_time_ - start_, t - start_) : t - newest_time_;
-    double a = newest_offset_ + va * travel;
+    double a = newest_offset_ + va * f_.integral(newest_time_, t);
     std::vector<Vec> x;
     while (a >= sa * (1 - 1e-9)) {
       a = std::max(a - sa, 0.0);
@@ -132,7 +130,7 @@ class Inflow : public Source<D> {
  private:
   Params params_;
   double start_, end_;
-  std::unique_ptr<TimeFunction<D>> f_;
+  TimeFactor<D> f_;  // its clock starts at start_
   Vec lo_{}, hi_{}, v_{}, s_{};
   int axis_ = 0, body_ = -1;
   bool filled_ = false;
@@ -164,11 +162,10 @@ class Inflow : public Source<D> {
     box_lattice<D>(sim.grid, lo_, hi_, s_, axis_, v_[size_t(axis_)] < 0, sites_, upstream_);
   }
 
-  /// v f(t - start), or v without a time function.
+  /// v f(t - start).
   Vec velocity(double t) const {
-    if (!f_) return v_;
     Vec v = v_;
-    for (auto& c : v) c *= f_->value(t - start_);
+    for (auto& c : v) c *= f_.value(t);
     return v;
   }
 

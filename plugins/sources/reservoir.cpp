@@ -24,9 +24,9 @@
 #include <memory>
 
 #include "framework/boundary.hpp"
+#include "framework/load_time.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
-#include "framework/time_function.hpp"
 #include "plugins/sources/box_lattice.hpp"
 
 namespace loam {
@@ -68,9 +68,7 @@ class Reservoir : public Source<D> {
     return s;
   }
   explicit Reservoir(const Params& p)
-      : params_(p), refill_(parse_face(p.text("refill"))), rate_(p.real("level_rate")) {
-    if (p.present("time_function"))
-      f_ = Registry::instance().create<TimeFunction, D>(p.section("time_function"));
+      : params_(p), refill_(parse_face(p.text("refill"))), rate_(p.real("level_rate")), f_(p) {
     for (int d = 0; d < D; ++d) {
       lo_[size_t(d)] = p.vec("min")[size_t(d)];
       hi_[size_t(d)] = p.vec("max")[size_t(d)];
@@ -161,7 +159,7 @@ class Reservoir : public Source<D> {
   /// level(t) = level + level_rate t (outward), never beyond the box's own end layer.
   double face_site(double t) const {
     const int a = refill_.axis;
-    const double travel = f_ ? f_->integral(0, t) : t;
+    const double travel = f_.integral(0, t);
     const double sa = s_[size_t(a)], level = level0_ + sign() * rate_ * travel;
     const double k = (level - origin_) / sa - 0.5, end = layer_[0][size_t(a)];
     const double y =
@@ -179,8 +177,8 @@ class Reservoir : public Source<D> {
   Params params_;
   Face refill_;
   Vec lo_{}, hi_{}, s_{};
-  double rate_ = 0, level0_ = 0, origin_ = 0;
-  std::unique_ptr<TimeFunction<D>> f_;  // origin_: the grid origin along the axis
+  double rate_ = 0, level0_ = 0, origin_ = 0;  // origin_: the grid origin along the axis
+  TimeFactor<D> f_;
   int body_ = -1;
   std::vector<Vec> sites_, layer_;  // every lattice site of the box; those of the refill layer
 };
