@@ -381,6 +381,9 @@ TEST_CASE("strain_softening_mc: bad parameters give the located error", "[materi
       {"E: 0, nu: 0.3, c_peak: 1000, c_residual: 0, phi_peak: 30, phi_residual: 20, "
        "psi_peak: 5, psi_residual: 0, softening_end: 0.1",
        ":7:61: error: bodies.0.material.E: 0 is out of range (0, inf) Pa"},
+      {"E: 1.0e6, nu: 0.3, c_peak: 1000, c_residual: 0, phi_peak: 30, phi_residual: 20, "
+       "psi_peak: 5, psi_residual: 0, softening_end: 0.1, characteristic_length: -1",
+       ":7:211: error: bodies.0.material.characteristic_length: -1 is out of range (0, inf) m"},
   };
   loam_test::check_bad_material("type: strain_softening_mc, density: 2000, ", cases);
 }
