@@ -117,19 +117,26 @@ void Run<D>::check_outputs(Diagnostics& diag) {
           diag.error(pr.where("fields"), pr.path("fields"),
                      "particle set '" + sim_->sets[size_t(probe.set)].name +
                          "' does not store field '" + name + "'");
-      if (ps.size() == 0) {
-        diag.error(pr.where("set"), pr.path("set"), "the particle set has no particles");
-        continue;
-      }
+      // The nearest particle of the set, those of its bodies that wait for a stage included
+      // (until its body joins the run, the probe's rows hold nan).
       const auto& target = pr.vec("particle_near");
       double best = 1e300;
-      for (size_t i = 0; i < ps.size(); ++i) {
-        double r2 = 0;
-        for (int d = 0; d < D; ++d) {
-          double dx = ps.col(ps.position, d)[i] - target[size_t(d)];
-          r2 += dx * dx;
+      auto nearest = [&](const Particles<D>& candidates) {
+        for (size_t i = 0; i < candidates.size(); ++i) {
+          double r2 = 0;
+          for (int d = 0; d < D; ++d) {
+            double dx = candidates.col(candidates.position, d)[i] - target[size_t(d)];
+            r2 += dx * dx;
+          }
+          if (r2 < best) best = r2, probe.particle_id = candidates.id[i];
         }
-        if (r2 < best) best = r2, probe.particle_id = ps.id[i];
+      };
+      nearest(ps);
+      for (size_t b = 0; b < sim_->bodies.size(); ++b)
+        if (sim_->body_set(int(b)) == probe.set) nearest(sim_->waiting_particles(int(b)));
+      if (best == 1e300) {
+        diag.error(pr.where("set"), pr.path("set"), "the particle set has no particles");
+        continue;
       }
     }
     probes_.push_back(std::move(probe));
@@ -254,7 +261,18 @@ void Run<D>::sample_probes(bool force) {
     } else {
       const ParticleSet<D>& set = sim_->sets[size_t(pr.set)];
       const Particles<D>& p = set.particles;
-      size_t i = set.index_of(pr.particle_id);
+      const size_t i = set.index_of(pr.particle_id);
+      if (i == set.npos) {  // not in the run: its body waits for a stage, or a sink took it
+        for (const auto& f : pr.fields) {
+          const int n = f == "displacement"       ? D
+                        : f == "strain_magnitude" ? 1
+                                                  : p.info(p.find(f)).components;
+          for (int c = 0; c < n; ++c) o << ",nan";
+        }
+        o << "\n";
+        pr.csv.check();
+        continue;
+      }
       for (const auto& f : pr.fields) {
         if (f == "displacement") {
           for (int d = 0; d < D; ++d)

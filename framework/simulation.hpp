@@ -230,6 +230,12 @@ class Simulation {
   const Particles<D>& particles_of_body(int body) const {
     return sets[size_t(body_set(body))].particles;
   }
+  /// The particles of a body that waits for a stage to activate it (`active: false`), kept
+  /// outside its set until then; empty for a body in the run.
+  const Particles<D>& waiting_particles(int body) const {
+    static const Particles<D> none;
+    return size_t(body) < inactive_.size() ? inactive_[size_t(body)] : none;
+  }
   /// The set a plugin names with `key` (absent: the scheme's first set), or -1 after a located
   /// "unknown set" error listing the sets.
   int set_param(const Params& p, const std::string& key, Diagnostics& diag) const;

@@ -93,7 +93,14 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
     }
   if (particles_ok) scheme->initial_state(*this);
   const size_t generated = num_particles();
-  if (particles_ok) keep_inactive_bodies_aside();
+  // Loads select their particles on the model as generated, the bodies that wait for a stage
+  // included (the tailings on a dam raise that a later stage activates); when applied they skip
+  // the particles not in the run.
+  if (particles_ok) {
+    for (auto& l : loads) l->setup(*this, diag);
+    setup_stage_plugins("loads", diag);
+    keep_inactive_bodies_aside();
+  }
   for (auto& b : boundaries) b->setup(*this, diag);
   setup_stage_plugins("boundaries", diag);
   check_periodic_faces(boundaries, config.list("boundaries"), diag);
@@ -103,9 +110,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   held_faces = HeldFaces<D>(grid, boundaries);
   held_faces_water = HeldFaces<D>(grid, boundaries, 1);
   model_checked = true;
-  if (!particles_ok) return;  // loads and references select particles
-  for (auto& l : loads) l->setup(*this, diag);
-  setup_stage_plugins("loads", diag);
+  if (!particles_ok) return;  // sources, sinks and references select particles
   for (auto& p : sources) p->setup(*this, diag);
   for (auto& p : sinks) p->setup(*this, diag);
   if (diag.ok()) check_sources_and_sinks(diag);

@@ -121,6 +121,51 @@ TEST_CASE("cavity_pressure: the wall particles carry the hole's area and the pre
   CHECK(f[2] == 0.0);
 }
 
+TEST_CASE("cavity_pressure: a pond against a block gives the hydrostatic force and its moment",
+          "[cavity][load]") {
+  // A block x in [2, 6], y in [0, 4] m; a pond (polygon x in [0, 2], y in [0, 5], vertices in
+  // either order) holds a fluid of unit weight gamma to level h = 3 m against its x- face, so
+  // p(y) = gamma (h - y) for y < h. Exact: horizontal resultant gamma h^2 / 2 on the block (+x),
+  // its moment about the base gamma h^3 / 6 (resultant at h/3), nothing vertical (the pond's
+  // floor and free surface have no block beside them; the samples above the level carry zero).
+  // The midpoint rule integrates the linear p exactly on each piece; the resultant's only error
+  // is the piece straddling y = h, and the moment's the particles' heights (forces act at the
+  // particle centres, up to s/2 from the wall samples): tolerances 1e-3 and 2 %.
+  const double gamma = 1.6e4, h = 3.0;
+  for (const char* vertices :
+       {"[[0, 0], [2, 0], [2, 5], [0, 5]]", "[[0, 5], [2, 5], [2, 0], [0, 0]]"}) {
+    const std::string cfg =
+        "grid: {extent: [6, 6], cell_size: 0.25}\n"
+        "gravity: [0, 0]\n"
+        "shape_function: gimp\n"
+        "bodies:\n"
+        "  - name: block\n"
+        "    particles_per_cell: 2\n"
+        "    generator: {type: box, min: [2, 0], max: [6, 4]}\n"
+        "    material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2000}\n"
+        "loads:\n"
+        "  - {type: cavity_pressure, body: block, cavity: {type: polygon, vertices: " +
+        std::string(vertices) +
+        "}, unit_weight: 1.6e4, level: 3}\n"
+        "time: {end: 1}\n";
+    auto sim = loam_test::make_simulation<2>(cfg);
+    const auto [f, loaded] = load_resultant(*sim);
+    const auto& P = sim->sets[0].particles;
+    double moment = 0;  // about the base y = 0
+    for (size_t i = 0; i < P.size(); ++i)
+      moment += P.col(sim->external_force, 0)[i] * P.col(P.position, 1)[i];
+    const double fx = gamma * h * h / 2, mx = gamma * h * h * h / 6;
+    std::printf(
+        "cavity_pressure pond (vertices %s): %zu loaded particles, resultant (%.1f, %.2e) N/m "
+        "against (%.1f, 0): error %+.2e; moment %.1f N m/m against %.1f: error %+.2e\n",
+        vertices, loaded, f[0], f[1], fx, f[0] / fx - 1, moment, mx, moment / mx - 1);
+    CHECK(std::fabs(f[0] / fx - 1) < 1e-3);
+    CHECK(std::fabs(f[1]) < 1e-9 * fx);
+    CHECK(std::fabs(moment / mx - 1) < 0.02);
+    CHECK(loaded == size_t(h / 0.125));  // the column of particles on the face, below the level
+  }
+}
+
 TEST_CASE("cavity_pressure: a pressurised hole in an elastic plate gives Lame's stresses",
           "[cavity][verification]") {
   // docs/verification.md N. Thick cylinder (Lamé), plane strain, inner radius a, free outer
@@ -214,6 +259,18 @@ TEST_CASE("cavity_pressure and the region generators: bad input gives located er
        "{type: cavity_pressure, body: rock, cavity: {type: sphere, center: [0, 0], "
        "radius: 1}, pressure: 1.0e5}",
        "loads.0.body: unknown body 'rock'"},
+      {hole,
+       "{type: cavity_pressure, body: plate, cavity: {type: cylinder, center: [0, 0], radius: "
+       "1}, unit_weight: 1.0e4}",
+       "loads.0.unit_weight: a unit_weight needs the `level` of the fluid's surface"},
+      {hole,
+       "{type: cavity_pressure, body: plate, cavity: {type: cylinder, center: [0, 0], radius: "
+       "1}, level: 2}",
+       "loads.0.level: a `level` needs a unit_weight > 0"},
+      {hole,
+       "{type: cavity_pressure, body: plate, cavity: {type: cylinder, center: [0, 0], radius: "
+       "1}}",
+       "loads.0.pressure: the load is zero"},
       {"{type: difference, of: {type: box, min: [0, 0], max: [4, 4]}, minus: []}", load,
        "bodies.0.generator.minus: give at least one region to subtract"},
       {"{type: intersection, of: [{type: box, min: [0, 0], max: [4, 4]}]}", load,

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <map>
 
 #include "cli.hpp"
@@ -267,6 +268,73 @@ TEST_CASE("bodies activated and deactivated by stages carry their weight exactly
   CHECK(s["mass"]["created"].get<double>() == Approx(2000).epsilon(1e-12));
   CHECK(s["mass"]["removed"].get<double>() == Approx(2000).epsilon(1e-12));
   CHECK(s["particles"].get<long>() == 20);
+}
+
+TEST_CASE("a stage's load and a probe may name a body that waits for that stage", "[stages]") {
+  // configs/construction_column_1d.yaml's two bodies (rho = 2000 kg/m^3, 1 m each, 1D elastic,
+  // fixed base), the upper one `active: false`. Stage 2 activates it and puts a traction of
+  // -1000 Pa on its top; a probe follows its top particle. Loads and probes select their
+  // particles on the model as generated (docs/stages.md), so both find the waiting body: the
+  // probe's rows read nan until the body joins, and at rest in stage 2 the bottom cell carries
+  // -rho g (2 - 0.05) - 1000 Pa exactly (tolerance 0.5 %, as the construction test above).
+  loam_test::TempDir d("stage_waiting_body");
+  const std::string yaml =
+      "grid: {extent: [2.2], cell_size: 0.1}\n"
+      "gravity: [-9.81]\n"
+      "bodies:\n"
+      "  - name: lower\n"
+      "    generator: {type: box, min: [0], max: [1]}\n"
+      "    material: {type: linear_elastic, E: 1.0e8, nu: 0, density: 2000}\n"
+      "  - name: upper\n"
+      "    generator: {type: box, min: [1], max: [2]}\n"
+      "    material: {type: linear_elastic, E: 1.0e8, nu: 0, density: 2000}\n"
+      "    active: false\n"
+      "boundaries:\n"
+      "  - {type: fixed, face: x-}\n"
+      "damping: {type: local, alpha: 0.7}\n"
+      "time: {cfl: 0.5}\n"
+      "output: {every_time: 0.5, fields: [stress]}\n"
+      "probes:\n"
+      "  - {name: base, particle_near: [0.025], fields: [stress], every_steps: 1}\n"
+      "  - {name: upper_top, particle_near: [1.975], fields: [position, stress], every_steps: "
+      "1}\n"
+      "stages:\n"
+      "  - {name: settle, until: static, max_time: 2}\n"
+      "  - name: build\n"
+      "    until: static\n"
+      "    max_time: 2\n"
+      "    activate: [upper]\n"
+      "    loads: [{type: traction, body: upper, face: x+, traction: [-1000]}]\n";
+  auto r = loam_test::run_yaml(d.path, yaml, "--threads 1");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  std::ifstream in(d.path / "out" / "summary.json");
+  const auto s = nlohmann::json::parse(in);
+  REQUIRE(s["stages"].size() == 2);
+  CHECK(s["stages"][1]["status"] == "static");
+  auto top = loam_test::read_csv_columns(d.path / "out" / "probe_upper_top.csv");
+  REQUIRE(top.count("position"));
+  const double t1 = s["stages"][0]["end_time"].get<double>();
+  size_t waiting = 0, joined = 0;
+  for (size_t i = 0; i < top["time"].size(); ++i) {
+    if (top["time"][i] <= t1 + 1e-12) {
+      waiting += std::isnan(top["position"][i]);
+      CHECK(std::isnan(top["position"][i]));
+    } else {
+      joined += std::isfinite(top["position"][i]);
+      CHECK(std::abs(top["position"][i] - 1.975) < 0.01);
+    }
+  }
+  CHECK(waiting > 0);
+  CHECK(joined > 0);
+  auto base = loam_test::read_csv_columns(d.path / "out" / "probe_base.csv");
+  const double sigma = sample_at(base, "stress_xx", s["stages"][1]["end_time"].get<double>());
+  const double exact = -2000 * 9.81 * (2 - 0.05) - 1000;
+  std::printf(
+      "waiting body: %zu probe rows nan before it joins, %zu after; base stress %.1f Pa "
+      "at rest, exact %.1f Pa, error %.3f %% (tolerance 0.5 %%)\n",
+      waiting, joined, sigma, exact, 100 * (sigma / exact - 1));
+  CHECK(std::abs(sigma / exact - 1) <= 0.005);
 }
 
 TEST_CASE(

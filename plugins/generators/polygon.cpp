@@ -1,4 +1,7 @@
 // Simple polygon (2D only): particles at lattice points inside it (even-odd rule).
+#include <algorithm>
+#include <cmath>
+
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 
@@ -38,6 +41,31 @@ class Polygon : public Generator<D> {
     }
   }
   std::array<double, D> lower() const override { return bound(false); }
+  /// Each edge split into equal pieces at most `spacing` long, one sample at each piece's
+  /// midpoint with the edge's outward normal (the side away from the polygon's interior, from
+  /// the sign of its area, so either vertex order works) and the piece's length as its area.
+  std::vector<typename Generator<D>::SurfaceSample> surface_samples(double spacing) const override {
+    std::vector<typename Generator<D>::SurfaceSample> out;
+    if constexpr (D == 2) {
+      double twice_area = 0;
+      for (size_t i = 0, j = v_.size() - 1; i < v_.size(); j = i++)
+        twice_area += v_[j][0] * v_[i][1] - v_[i][0] * v_[j][1];
+      const double turn = twice_area > 0 ? 1.0 : -1.0;  // counter-clockwise: normal (dy, -dx)
+      for (size_t j = 0; j < v_.size(); ++j) {
+        const auto &a = v_[j], &b = v_[(j + 1) % v_.size()];
+        const double dx = b[0] - a[0], dy = b[1] - a[1], length = std::hypot(dx, dy);
+        if (length == 0) continue;
+        const int pieces = std::max(1, int(std::ceil(length / spacing)));
+        for (int k = 0; k < pieces; ++k) {
+          const double t = (k + 0.5) / pieces;
+          out.push_back({{a[0] + t * dx, a[1] + t * dy},
+                         {turn * dy / length, -turn * dx / length},
+                         length / pieces});
+        }
+      }
+    }
+    return out;
+  }
   std::array<double, D> upper() const override { return bound(true); }
 
  private:

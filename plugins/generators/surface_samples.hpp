@@ -30,7 +30,7 @@ std::vector<typename Generator<D>::SurfaceSample> cavity_wall(const Generator<D>
   if (wall.empty())
     diag.error(p.where(key), p.path(key),
                "a '" + p.section(key).type() +
-                   "' region does not describe its surface; a cavity is a sphere or a cylinder");
+                   "' region does not describe its surface; a cavity is a sphere, a cylinder or a polygon");
   return wall;
 }
 

@@ -1,17 +1,20 @@
-// Pressure on the wall of a cavity inside a body: a borehole charge, a pressurised tunnel, a
-// cavity expansion. The cavity is a generator region that describes its surface (sphere,
-// cylinder); usually the same region the body's `difference` generator left empty. Its wall is
-// sampled with quadrature points x_q (normal n_q, area A_q, about a quarter particle spacing apart,
-// Generator::surface_samples, whose areas sum to the wall's exactly), and each sample's force
-// goes to the body particle nearest to it:
-//   f_p = p f(t) sum_{q -> p} A_q n_q,
-// n_q the cavity's outward normal (away from the cavity, into the body). So the loaded area and
-// the resultant are the wall's to round-off, whatever the lattice, and each wall particle is
+// Pressure on the wall of a cavity inside a body, or of an empty region beside it: a borehole
+// charge, a pressurised tunnel, a cavity expansion, a pond or tailings lagoon against a dam's face
+// and its floor. The cavity is a generator region that describes its surface (sphere, cylinder,
+// polygon); usually the same region the body's `difference` generator left empty, or a region the
+// body's own boundary bounds. Its wall is sampled with quadrature points x_q (normal n_q, area
+// A_q, about a quarter particle spacing apart, Generator::surface_samples, whose areas sum to the
+// wall's exactly), and each sample's force goes to the body particle nearest to it:
+//   f_p = f(t) sum_{q -> p} p(x_q) A_q n_q,   p(x) = pressure + unit_weight max(0, level - x_v),
+// n_q the cavity's outward normal (away from the cavity, into the body), x_v the vertical
+// coordinate (y in 2D, z in 3D): a uniform pressure plus, optionally, the hydrostatic pressure
+// of a fluid standing to `level` (water, or tailings as an equivalent fluid). So the loaded area
+// and the resultant are the wall's to round-off, whatever the lattice, and each wall particle is
 // pushed along its own share of the wall's normal. Samples the body does not cover (beyond a
-// quarter model's symmetry planes: the body's region does not hold x_q + (s/2) n_q, s the particle
-// spacing) are dropped, as are samples with no body particle within 2 s. Normals and areas are
-// those of the reference configuration (a nominal pressure, as `traction`'s); the forces act at
-// the particle centres.
+// quarter model's symmetry planes, a pond's free surface, another body's part of the wall: the
+// body's region does not hold x_q + (s/2) n_q, s the particle spacing) are dropped, as are
+// samples with no body particle within 2 s. Normals and areas are those of the reference
+// configuration (a nominal pressure, as `traction`'s); the forces act at the particle centres.
 #include <cmath>
 #include <map>
 #include <memory>
@@ -28,24 +31,48 @@ class CavityPressure : public Load<D> {
  public:
   static constexpr const char* name = "cavity_pressure";
   static constexpr const char* summary =
-      "pressure on a cavity's wall (borehole, tunnel): each wall particle pushed along its own "
-      "outward normal";
+      "pressure on a cavity's wall (borehole, tunnel) or a pond's bed and banks (uniform, "
+      "hydrostatic or both): each wall particle pushed along its own outward normal";
   static Schema schema() {
     Schema s;
     s.text("body", "body around the cavity").required();
     s.plugin("cavity", "generator",
-             "the cavity: a region that describes its surface (sphere, cylinder); only its wall "
-             "is loaded (not a cylinder's ends)")
+             "the cavity: a region that describes its surface (sphere, cylinder, polygon); only "
+             "its wall beside the body is loaded (not a cylinder's ends, not a pond's free "
+             "surface)")
         .required();
-    s.real("pressure", "Pa", "pressure in the cavity (positive pushes the wall outwards)")
-        .required();
+    s.real("pressure", "Pa",
+           "uniform pressure in the cavity (positive pushes the wall outwards); give it, a "
+           "unit_weight, or both")
+        .def("0");
+    s.real("unit_weight", "N/m^3",
+           "hydrostatic part: unit_weight (level - x_v) where the wall lies below `level`, x_v "
+           "the vertical coordinate (y in 2D, z in 3D): the pressure of a fluid filling the cavity "
+           "to that level (water 9810; tailings as an equivalent fluid)")
+        .def("0")
+        .min(0);
+    s.real("level", "m",
+           "height (y in 2D, z in 3D) of the fluid surface; required with unit_weight");
     add_load_time_keys(s);
+    s.check([](const Params& p, Diagnostics& d) {
+      const bool fluid = p.real("unit_weight") > 0;
+      if (fluid && !p.present("level"))
+        d.error(p.where("unit_weight"), p.path("unit_weight"),
+                "a unit_weight needs the `level` of the fluid's surface");
+      if (!fluid && p.present("level"))
+        d.error(p.where("level"), p.path("level"), "a `level` needs a unit_weight > 0");
+      if (!fluid && p.real("pressure") == 0)
+        d.error(p.where("pressure"), p.path("pressure"),
+                "the load is zero: give a pressure or a unit_weight with a level");
+    });
     return s;
   }
   explicit CavityPressure(const Params& p)
       : params_(p),
         cavity_(Registry::instance().create<Generator, D>(p.section("cavity"))),
         pressure_(p.real("pressure")),
+        unit_weight_(p.real("unit_weight")),
+        level_(p.present("level") ? p.real("level") : 0.0),
         time_(p) {}
   bool uses_particle_forces() const override { return true; }
 
@@ -79,12 +106,13 @@ class CavityPressure : public Load<D> {
   }
 
   void apply_to_particles(Simulation<D>& sim, double t) override {
-    const double p = pressure_ * time_(t);
+    const double f = time_(t);
     auto& set = sim.sets[size_t(set_)];
     auto& P = set.particles;
     for (size_t k = 0; k < ids_.size(); ++k) {
       const size_t i = set.index_of(ids_[k]);
-      for (int d = 0; d < D; ++d) P.col(sim.external_force, d)[i] += p * area_vector_[k][size_t(d)];
+      if (i == set.npos) continue;  // not in the run (its body waits for a stage)
+      for (int d = 0; d < D; ++d) P.col(sim.external_force, d)[i] += f * force_[k][size_t(d)];
     }
   }
 
@@ -108,7 +136,12 @@ class CavityPressure : public Load<D> {
     return n;
   }
 
-  /// Each wall sample's area vector A_q n_q to the nearest body particle (within 2 s), found
+  /// Pressure at a wall sample (before the time factor).
+  double pressure_at(const std::array<double, D>& x) const {
+    return pressure_ + unit_weight_ * std::max(0.0, level_ - x[size_t(D - 1)]);
+  }
+
+  /// Each wall sample's force p(x_q) A_q n_q to the nearest body particle (within 2 s), found
   /// through a hash of the particles near the cavity by cells of size s.
   void assign_samples(const Simulation<D>& sim, int b, const Generator<D>& region,
                       const std::vector<typename Generator<D>::SurfaceSample>& wall, double s) {
@@ -126,7 +159,7 @@ class CavityPressure : public Load<D> {
       }
       if (close) near[cell_of(x, s)].push_back(i);
     }
-    std::map<size_t, std::array<double, D>> share;  // particle index -> sum A_q n_q
+    std::map<size_t, std::array<double, D>> share;  // particle index -> sum p_q A_q n_q
     for (const auto& q : wall) {
       std::array<double, D> outside{};
       for (int d = 0; d < D; ++d)
@@ -151,21 +184,22 @@ class CavityPressure : public Load<D> {
       }
       if (best == SIZE_MAX) continue;
       auto& a = share[best];
-      for (int d = 0; d < D; ++d) a[size_t(d)] += q.area * q.normal[size_t(d)];
+      const double pa = pressure_at(q.x) * q.area;
+      for (int d = 0; d < D; ++d) a[size_t(d)] += pa * q.normal[size_t(d)];
     }
     for (const auto& [i, a] : share) {
       ids_.push_back(P.id[i]);
-      area_vector_.push_back(a);
+      force_.push_back(a);
     }
   }
 
   Params params_;
   std::unique_ptr<Generator<D>> cavity_;
-  double pressure_;
+  double pressure_, unit_weight_, level_;
   LoadTime<D> time_;
   int set_ = 0;
   std::vector<uint32_t> ids_;
-  std::vector<std::array<double, D>> area_vector_;
+  std::vector<std::array<double, D>> force_;  // sum p_q A_q n_q per particle, at f(t) = 1
 };
 
 LOAM_REGISTER(Load, CavityPressure)

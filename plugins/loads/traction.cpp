@@ -124,6 +124,7 @@ class Traction : public Load<D> {
     const int a = face_.axis;
     for (size_t k = 0; k < ids_.size(); ++k) {
       const size_t i = set.index_of(ids_[k]);
+      if (i == set.npos) continue;  // not in the run (its body waits for a stage)
       // Surface point x_p + F (s/2) N (N = +-e_a, so F N is column a of F) and its cell: per
       // axis the lower node and the tent weight of the upper.
       const double half = (face_.upper ? 0.5 : -0.5) * length_[k];
@@ -155,7 +156,8 @@ class Traction : public Load<D> {
     auto& set = sim.sets[size_t(set_)];
     auto& P = set.particles;
     for (size_t k = 0; k < ids_.size(); ++k) {
-      size_t i = set.index_of(ids_[k]);
+      const size_t i = set.index_of(ids_[k]);
+      if (i == set.npos) continue;  // not in the run (its body waits for a stage)
       for (int d = 0; d < D; ++d) P.col(sim.external_force, d)[i] += s * t_[size_t(d)] * area_[k];
     }
   }
