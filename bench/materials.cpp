@@ -27,6 +27,8 @@ const MaterialCase kCases[] = {
     {"linear_elastic", "{type: linear_elastic, E: 20.0e6, nu: 0.3, density: 2000}"},
     {"mohr_coulomb",
      "{type: mohr_coulomb, E: 20.0e6, nu: 0.3, density: 2000, c: 5000, phi: 30, psi: 10}"},
+    {"drucker_prager",
+     "{type: drucker_prager, E: 20.0e6, nu: 0.3, density: 2000, c: 5000, phi: 30, psi: 10}"},
     {"strain_softening_mc",
      "{type: strain_softening_mc, E: 20.0e6, nu: 0.3, density: 2000, c_peak: 5000, "
      "phi_peak: 35, psi_peak: 5, c_residual: 0, phi_residual: 25, psi_residual: 0, "
