@@ -2,8 +2,26 @@
 // Nairn 2003): lumped mass, FLIP/PIC blend for the particle velocity, stress update before the
 // force computation (USF), after the grid update (USL), or after re-mapping the updated particle
 // momentum to the grid (MUSL, the default; least noisy for near-empty nodes).
+//
+// `transfer: apic` (MUSL): the affine particle-in-cell transfer of Jiang et al. (2015). Each
+// particle carries the velocity's first moment about it, B_p (field affine_moment). G2P from the
+// updated grid velocities v_I, at the particle's position before the move:
+//   v_p = sum_I N_Ip v_I,   B_p = sum_I N_Ip v_I (x_I - x_p)^T;
+// P2G (and the MUSL re-map), with the inertia D_p = sum_I N_Ip (x_I - x_p)(x_I - x_p)^T of the
+// particle's current position:
+//   (m v)_I = sum_p m_p N_Ip (v_p + B_p D_p^-1 (x_I - x_p)).
+// D_p comes from the weights: h^2/4 I for interior quadratic B-splines, GIMP's and CPDI's from
+// their domain-averaged weights (invertible: a domain spans nodes). Multilinear tents are
+// refused: there N_Ip D_p^-1 (x_I - x_p) = grad N_Ip (Jiang et al. 2015, section 5.3), which does
+// not vanish with N_Ip, so a node that a particle just reaches gets the full affine momentum on a
+// vanishing mass; a translating bar blew up at its free end's first cell crossing (2026-12-04).
+// Keeping B_p, not C_p = B_p D_p^-1, and taking D_p where the
+// particle is when it scatters is what conserves angular momentum over the move for weights whose
+// D_p changes with position. Linear and angular momentum are conserved by the transfers; the
+// affine part carries no PIC dissipation and no FLIP noise (tests/test_apic.cpp).
 #include <omp.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -27,11 +45,23 @@ class SinglePhase : public Scheme<D> {
              "grid update), usf (before forces)")
         .def("musl");
     add_flip_param(s);
+    s.choice("transfer", {"flip", "apic"},
+             "particle-grid velocity transfer: flip (the FLIP/PIC blend of `flip`) or apic "
+             "(affine particle-in-cell, Jiang et al. 2015: each particle carries an affine "
+             "velocity matrix; no PIC dissipation, no FLIP noise; update: musl)")
+        .def("flip");
     s.string_list("sets",
                   "names of the particle sets; all are summed onto the one velocity field (e.g. "
                   "a column split into two sets behaves as one), each has its own output frames")
         .def("[particles]");
     s.check([](const Params& p, Diagnostics& d) {
+      if (p.text("transfer") == "apic" && p.text("update") != "musl")
+        d.error(p.where("transfer"), p.path("transfer"),
+                "transfer: apic is implemented for update: musl only (this scheme has update: " +
+                    p.text("update") + ")");
+      if (p.text("transfer") == "apic" && p.given("flip"))
+        d.error(p.where("flip"), p.path("flip"),
+                "flip blends FLIP and PIC; transfer: apic replaces both (remove flip)");
       const auto& names = p.strings("sets");
       if (names.empty()) d.error(p.where("sets"), p.path("sets"), "give at least one set");
       for (size_t i = 0; i < names.size(); ++i) {
@@ -51,7 +81,11 @@ class SinglePhase : public Scheme<D> {
     return s;
   }
   explicit SinglePhase(const Params& p)
-      : update_(p.text("update")), flip_(p.real("flip")), sets_(p.strings("sets")) {}
+      : params_(p),
+        update_(p.text("update")),
+        flip_(p.real("flip")),
+        apic_(p.text("transfer") == "apic"),
+        sets_(p.strings("sets")) {}
 
   std::vector<SetDeclaration> particle_sets() const override {
     std::vector<SetDeclaration> s;
@@ -59,11 +93,21 @@ class SinglePhase : public Scheme<D> {
     return s;
   }
 
-  void setup(Simulation<D>& sim, Diagnostics&) override {
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
     node_.assign(sim.grid.num_nodes * S, 0.0);
     vel_.assign(sim.grid.num_nodes * D, 0.0);
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch&) {});
+    if (!apic_) return;
+    affine_ = sim.request_field(affine_moment_info());
+    node_x_.resize(sim.grid.num_nodes * D);  // node coordinates: x_I - x_p without divisions
+    for (size_t n = 0; n < sim.grid.num_nodes; ++n)
+      for (int d = 0; d < D; ++d) node_x_[n * D + size_t(d)] = sim.grid.node_coord(n, d);
+    if (!sim.shape->stencil_covers_domain())
+      diag.error(params_.where("transfer"), params_.path("transfer"),
+                 "transfer: apic needs a shape function whose weights cover the particle's "
+                 "domain (gimp, bspline2, cpdi): with linear tents a node that a particle just "
+                 "reaches gets the full affine momentum on a vanishing mass, and the run blows up");
   }
 
   std::vector<GridFieldView> grid_fields() const override {
@@ -89,8 +133,12 @@ class SinglePhase : public Scheme<D> {
   // momentum slot holds the updated velocity and the force slot the acceleration.
   static constexpr int kMass = 0, kMomentum = 1, kForce = 1 + D, S = 1 + 2 * D;
   static constexpr int NS = Particles<D>::NS;
+  Params params_;
   std::string update_;
   double flip_;
+  bool apic_;
+  int affine_ = -1;             // APIC's B_p (D x D, row-major; field affine_moment), or -1
+  std::vector<double> node_x_;  // APIC: node coordinates, num_nodes * D
   std::vector<std::string> sets_;
   int F_ = -1;                // deformation gradient handle, or -1
   std::vector<double> node_;  // num_nodes * S
@@ -112,7 +160,14 @@ class SinglePhase : public Scheme<D> {
       // MUSL: re-map the updated particle momentum; the velocity gradient uses that field, and
       // particles move with the grid velocity of the update (Sulsky 1995).
       sim.timed("grid", [&] { zero_nodes(vel_, sim.threads); });
-      sim.timed("g2p_velocity_remap", [&] { update_velocities<NPP, true, false>(sim, dt); });
+      if (apic_)
+        sim.timed("g2p_velocity_remap", [&] {
+          sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+            update_velocity_apic<NPP>(sim, s, b, c, t);
+          });
+        });
+      else
+        sim.timed("g2p_velocity_remap", [&] { update_velocities<NPP, true, false>(sim, dt); });
       sim.timed("grid", [&] { momentum_to_velocity(sim, vel_.data(), D, 0); });
       sim.timed("g2p_gradient_stress", [&] { update_stresses<NPP, Gradient::kRemapped>(sim, dt); });
     } else {
@@ -189,14 +244,19 @@ class SinglePhase : public Scheme<D> {
     for (int c = 0; c < NS; ++c) sig[size_t(c)] = P.col(P.stress, c) + b;
     double* g = node_.data();
     const std::array<double, D> gravity = sim.gravity;
+    const bool affine = MOMENTUM && affine_ >= 0;
     for (int p = 0; p < count; ++p) {
       // Particle values in locals: the node stores below could alias the particle columns.
       const double mp = m[p];
-      double mv[D], body[D], sv[D][D];
+      double mv[D], body[D], sv[D][D], mC[D][D] = {}, xp[D] = {};  // mC: m_p B_p D_p^-1
       for (int d = 0; d < D; ++d) {
         mv[d] = mp * v[size_t(d)][p];
         body[d] = mp * gravity[size_t(d)] + (fe[size_t(d)] ? fe[size_t(d)][p] : 0.0);
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * sig[size_t(voigt_index(d, j))][p];
+      }
+      if (affine) {
+        for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[b + size_t(p)];
+        affine_momentum_matrix(sim, P, st, b + size_t(p), p, npp, xp, mC);
       }
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -204,7 +264,13 @@ class SinglePhase : public Scheme<D> {
         double* r = g + size_t(st.node[kp]) * S;
         if constexpr (MOMENTUM) {
           r[kMass] += w * mp;
-          for (int d = 0; d < D; ++d) r[kMomentum + d] += w * mv[d];
+          if (affine) {  // APIC: m_p (N v_p + B_p D_p^-1 N (x_I - x_p)), see the header
+            double a[D];
+            affine_momentum(st, k, p, xp, w, mv, mC, a);
+            for (int d = 0; d < D; ++d) r[kMomentum + d] += a[d];
+          } else {
+            for (int d = 0; d < D; ++d) r[kMomentum + d] += w * mv[d];
+          }
         }
         if constexpr (FORCE) {
           double gr[D];
@@ -324,6 +390,103 @@ class SinglePhase : public Scheme<D> {
       }
     }
     sc.max_v2 = max_v2;
+  }
+
+  /// x_I - x_p for node n.
+  std::array<double, D> node_offset(int32_t n, const double* xp) const {
+    std::array<double, D> dx{};
+    for (int d = 0; d < D; ++d) dx[size_t(d)] = node_x_[size_t(n) * D + size_t(d)] - xp[d];
+    return dx;
+  }
+
+  /// m_p B_p D_p^-1 for particle p of the block (stencil st at its position xp).
+  void affine_momentum_matrix(const Simulation<D>& sim, const Particles<D>& P,
+                              const StencilBlock<D>& st, size_t i, int p, int npp, const double* xp,
+                              double (&mC)[D][D]) const {
+    using Mat = Eigen::Matrix<double, D, D>;
+    Mat B;
+    const double mp = P.col(P.mass)[i];
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) B(d, j) = mp * P.col(affine_, d * D + j)[i];
+    Mat Dp = Mat::Zero();
+    for (int k = 0; k < npp; ++k) {
+      const size_t kp = size_t(k) * kBlock + size_t(p);
+      const auto dx = node_offset(st.node[kp], xp);
+      for (int d = 0; d < D; ++d)
+        for (int j = 0; j < D; ++j) Dp(d, j) += st.w[kp] * dx[size_t(d)] * dx[size_t(j)];
+    }
+    B = B * Dp.inverse();
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) mC[d][j] = B(d, j);
+  }
+
+  /// The momentum stencil entry k of particle p sends to its node: w m v_p plus the affine part
+  /// (m B D^-1) w (x_I - x_p).
+  void affine_momentum(const StencilBlock<D>& st, int k, int p, const double* xp, double w,
+                       const double (&mv)[D], const double (&mC)[D][D], double (&out)[D]) const {
+    const auto dx = node_offset(st.node[size_t(k) * kBlock + size_t(p)], xp);
+    for (int d = 0; d < D; ++d) {
+      out[d] = w * mv[d];
+      for (int j = 0; j < D; ++j) out[d] += w * mC[d][j] * dx[size_t(j)];
+    }
+  }
+
+  /// APIC grid-to-particle update of one block (the header's equations) from the updated grid
+  /// velocities, and the MUSL re-map of the new particle momenta, affine part included, into
+  /// vel_.
+  template <int NPP>
+  void update_velocity_apic(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count,
+                            int thread) {
+    Particles<D>& P = set.particles;
+    Scratch& sc = *scratch_[size_t(thread)];
+    StencilBlock<D>& st = sc.stencil;
+    sim.shape->evaluate(sim.grid, P, b, count, st);
+    const int npp = NPP ? NPP : st.npp;
+    const double* g = node_.data();
+    double* remap = vel_.data();
+    double max_v2 = sc.max_v2;
+    for (int p = 0; p < count; ++p) {
+      const size_t i = b + size_t(p);
+      double xp[D], vp[D] = {}, B[D][D] = {};
+      for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        const double w = st.w[kp];
+        const double* vI = g + size_t(st.node[kp]) * S + kMomentum;
+        const auto dx = node_offset(st.node[kp], xp);
+        for (int d = 0; d < D; ++d) {
+          vp[d] += w * vI[d];
+          for (int j = 0; j < D; ++j) B[d][j] += w * vI[d] * dx[size_t(j)];
+        }
+      }
+      double v2 = 0, mv[D], mC[D][D];
+      const double mp = P.col(P.mass)[i];
+      for (int d = 0; d < D; ++d) {
+        P.col(P.velocity, d)[i] = vp[d];
+        mv[d] = mp * vp[d];
+        v2 += vp[d] * vp[d];
+        for (int j = 0; j < D; ++j) P.col(affine_, d * D + j)[i] = B[d][j];
+      }
+      max_v2 = std::max(max_v2, v2);
+      affine_momentum_matrix(sim, P, st, i, p, npp, xp, mC);
+      for (int k = 0; k < npp; ++k) {
+        double a[D];
+        affine_momentum(st, k, p, xp, st.w[size_t(k) * kBlock + size_t(p)], mv, mC, a);
+        double* r = remap + size_t(st.node[size_t(k) * kBlock + size_t(p)]) * D;
+        for (int d = 0; d < D; ++d) r[d] += a[d];
+      }
+    }
+    sc.max_v2 = max_v2;
+  }
+
+  static FieldInfo affine_moment_info() {
+    std::vector<std::string> names;
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j) names.push_back(std::string(1, "xyz"[i]) + "xyz"[j]);
+    return {"affine_moment", D * D, "m^2/s",
+            "APIC's B_p = sum_I N_Ip v_I (x_I - x_p)^T (Jiang et al. 2015): with the inertia D_p "
+            "the particle's velocity field is v_p + B_p D_p^-1 (x - x_p)",
+            names};
   }
 
   /// Velocity gradient, volume and F update, optional move / velocity update, and the
