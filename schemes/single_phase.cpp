@@ -103,6 +103,11 @@ class SinglePhase : public Scheme<D> {
     node_x_.resize(sim.grid.num_nodes * D);  // node coordinates: x_I - x_p without divisions
     for (size_t n = 0; n < sim.grid.num_nodes; ++n)
       for (int d = 0; d < D; ++d) node_x_[n * D + size_t(d)] = sim.grid.node_coord(n, d);
+    if (sim.shape->max_nodes_per_particle() > kMaxEntries)
+      diag.error(params_.where("transfer"), params_.path("transfer"),
+                 "transfer: apic handles stencils of up to " + std::to_string(kMaxEntries) +
+                     " nodes; this shape function uses " +
+                     std::to_string(sim.shape->max_nodes_per_particle()));
     if (!sim.shape->stencil_covers_domain())
       diag.error(params_.where("transfer"), params_.path("transfer"),
                  "transfer: apic needs a shape function whose weights cover the particle's "
@@ -245,6 +250,7 @@ class SinglePhase : public Scheme<D> {
     double* g = node_.data();
     const std::array<double, D> gravity = sim.gravity;
     const bool affine = MOMENTUM && affine_ >= 0;
+    AffineStencil as;
     for (int p = 0; p < count; ++p) {
       // Particle values in locals: the node stores below could alias the particle columns.
       const double mp = m[p];
@@ -255,8 +261,13 @@ class SinglePhase : public Scheme<D> {
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * sig[size_t(voigt_index(d, j))][p];
       }
       if (affine) {
-        for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[b + size_t(p)];
-        affine_momentum_matrix(sim, P, st, b + size_t(p), p, npp, xp, mC);
+        double B[D][D];
+        for (int d = 0; d < D; ++d) {
+          xp[d] = P.col(P.position, d)[b + size_t(p)];
+          for (int j = 0; j < D; ++j) B[d][j] = P.col(affine_, d * D + j)[b + size_t(p)];
+        }
+        affine_stencil(st, p, npp, xp, as);
+        affine_matrix(mp, B, as.inertia, mC);
       }
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -266,7 +277,7 @@ class SinglePhase : public Scheme<D> {
           r[kMass] += w * mp;
           if (affine) {  // APIC: m_p (N v_p + B_p D_p^-1 N (x_I - x_p)), see the header
             double a[D];
-            affine_momentum(st, k, p, xp, w, mv, mC, a);
+            affine_momentum(w, as.dx[k], mv, mC, a);
             for (int d = 0; d < D; ++d) r[kMomentum + d] += a[d];
           } else {
             for (int d = 0; d < D; ++d) r[kMomentum + d] += w * mv[d];
@@ -392,42 +403,43 @@ class SinglePhase : public Scheme<D> {
     sc.max_v2 = max_v2;
   }
 
-  /// x_I - x_p for node n.
-  std::array<double, D> node_offset(int32_t n, const double* xp) const {
-    std::array<double, D> dx{};
-    for (int d = 0; d < D; ++d) dx[size_t(d)] = node_x_[size_t(n) * D + size_t(d)] - xp[d];
-    return dx;
-  }
-
-  /// m_p B_p D_p^-1 for particle p of the block (stencil st at its position xp).
-  void affine_momentum_matrix(const Simulation<D>& sim, const Particles<D>& P,
-                              const StencilBlock<D>& st, size_t i, int p, int npp, const double* xp,
-                              double (&mC)[D][D]) const {
-    using Mat = Eigen::Matrix<double, D, D>;
-    Mat B;
-    const double mp = P.col(P.mass)[i];
-    for (int d = 0; d < D; ++d)
-      for (int j = 0; j < D; ++j) B(d, j) = mp * P.col(affine_, d * D + j)[i];
-    Mat Dp = Mat::Zero();
+  /// Entries of a stencil APIC handles per particle (CPDI's widest, 4^D).
+  static constexpr int kMaxEntries = ipow(4, D);
+  /// x_I - x_p of every stencil entry of particle p (position xp), and D_p's accumulation.
+  struct AffineStencil {
+    double dx[kMaxEntries][D];
+    Eigen::Matrix<double, D, D> inertia;
+  };
+  void affine_stencil(const StencilBlock<D>& st, int p, int npp, const double* xp,
+                      AffineStencil& a) const {
+    a.inertia.setZero();
     for (int k = 0; k < npp; ++k) {
       const size_t kp = size_t(k) * kBlock + size_t(p);
-      const auto dx = node_offset(st.node[kp], xp);
+      const double* xI = node_x_.data() + size_t(st.node[kp]) * D;
+      for (int d = 0; d < D; ++d) a.dx[k][d] = xI[d] - xp[d];
       for (int d = 0; d < D; ++d)
-        for (int j = 0; j < D; ++j) Dp(d, j) += st.w[kp] * dx[size_t(d)] * dx[size_t(j)];
+        for (int j = 0; j < D; ++j) a.inertia(d, j) += st.w[kp] * a.dx[k][d] * a.dx[k][j];
     }
-    B = B * Dp.inverse();
-    for (int d = 0; d < D; ++d)
-      for (int j = 0; j < D; ++j) mC[d][j] = B(d, j);
   }
 
-  /// The momentum stencil entry k of particle p sends to its node: w m v_p plus the affine part
-  /// (m B D^-1) w (x_I - x_p).
-  void affine_momentum(const StencilBlock<D>& st, int k, int p, const double* xp, double w,
-                       const double (&mv)[D], const double (&mC)[D][D], double (&out)[D]) const {
-    const auto dx = node_offset(st.node[size_t(k) * kBlock + size_t(p)], xp);
+  /// mC = m_p B_p D_p^-1, B given row-major.
+  static void affine_matrix(double mp, const double (&B)[D][D],
+                            const Eigen::Matrix<double, D, D>& inertia, double (&mC)[D][D]) {
+    Eigen::Matrix<double, D, D> Bm;
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) Bm(d, j) = mp * B[d][j];
+    const Eigen::Matrix<double, D, D> C = Bm * inertia.inverse();
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) mC[d][j] = C(d, j);
+  }
+
+  /// The momentum stencil entry k sends to its node: w (m v_p + (m B D^-1)(x_I - x_p)).
+  static void affine_momentum(double w, const double* dx, const double (&mv)[D],
+                              const double (&mC)[D][D], double (&out)[D]) {
     for (int d = 0; d < D; ++d) {
-      out[d] = w * mv[d];
-      for (int j = 0; j < D; ++j) out[d] += w * mC[d][j] * dx[size_t(j)];
+      double a = mv[d];
+      for (int j = 0; j < D; ++j) a += mC[d][j] * dx[j];
+      out[d] = w * a;
     }
   }
 
@@ -445,18 +457,19 @@ class SinglePhase : public Scheme<D> {
     const double* g = node_.data();
     double* remap = vel_.data();
     double max_v2 = sc.max_v2;
+    AffineStencil as;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       double xp[D], vp[D] = {}, B[D][D] = {};
       for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
+      affine_stencil(st, p, npp, xp, as);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
         const double* vI = g + size_t(st.node[kp]) * S + kMomentum;
-        const auto dx = node_offset(st.node[kp], xp);
         for (int d = 0; d < D; ++d) {
           vp[d] += w * vI[d];
-          for (int j = 0; j < D; ++j) B[d][j] += w * vI[d] * dx[size_t(j)];
+          for (int j = 0; j < D; ++j) B[d][j] += w * vI[d] * as.dx[k][j];
         }
       }
       double v2 = 0, mv[D], mC[D][D];
@@ -468,11 +481,12 @@ class SinglePhase : public Scheme<D> {
         for (int j = 0; j < D; ++j) P.col(affine_, d * D + j)[i] = B[d][j];
       }
       max_v2 = std::max(max_v2, v2);
-      affine_momentum_matrix(sim, P, st, i, p, npp, xp, mC);
+      affine_matrix(mp, B, as.inertia, mC);
       for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
         double a[D];
-        affine_momentum(st, k, p, xp, st.w[size_t(k) * kBlock + size_t(p)], mv, mC, a);
-        double* r = remap + size_t(st.node[size_t(k) * kBlock + size_t(p)]) * D;
+        affine_momentum(st.w[kp], as.dx[k], mv, mC, a);
+        double* r = remap + size_t(st.node[kp]) * D;
         for (int d = 0; d < D; ++d) r[d] += a[d];
       }
     }
