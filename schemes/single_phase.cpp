@@ -59,9 +59,10 @@ class SinglePhase : public Scheme<D> {
         d.error(p.where("transfer"), p.path("transfer"),
                 "transfer: apic is implemented for update: musl only (this scheme has update: " +
                     p.text("update") + ")");
-      if (p.text("transfer") == "apic" && p.given("flip"))
+      if (p.text("transfer") == "apic" && p.real("flip") != 1.0)
         d.error(p.where("flip"), p.path("flip"),
-                "flip blends FLIP and PIC; transfer: apic replaces both (remove flip)");
+                "flip blends FLIP and PIC; transfer: apic replaces both (remove flip or set it "
+                "to 1)");
       const auto& names = p.strings("sets");
       if (names.empty()) d.error(p.where("sets"), p.path("sets"), "give at least one set");
       for (size_t i = 0; i < names.size(); ++i) {
