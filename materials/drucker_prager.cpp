@@ -69,10 +69,7 @@ class DruckerPrager : public Material<D> {
         .required()
         .non_negative();
     s.real("phi", "deg", "friction angle (Mohr-Coulomb's)").required().min(0).below(90);
-    s.real("psi", "deg", "dilation angle (non-associated flow; psi <= phi)")
-        .required()
-        .min(0)
-        .below(90);
+    add_dilation_angle(s);
     s.choice("match", {"compression", "extension", "plane_strain"},
              "which Mohr-Coulomb states the cone passes through: compression (outer cone, "
              "triaxial compression exact), extension (inner cone, triaxial extension exact) or "
@@ -82,12 +79,6 @@ class DruckerPrager : public Material<D> {
            "largest mean stress p = tr(sigma)/3 (tension positive); default: the cone's apex "
            "xi c / eta, none when phi = 0")
         .non_negative();
-    s.check([](const Params& p, Diagnostics& d) {
-      if (p.real("psi") > p.real("phi"))
-        d.error(p.where("psi"), p.path("psi"),
-                "dilation angle psi = " + format_number(p.real("psi")) +
-                    " must not exceed the friction angle phi = " + format_number(p.real("phi")));
-    });
     return s;
   }
 

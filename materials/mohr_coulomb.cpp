@@ -37,20 +37,11 @@ class MohrCoulomb : public Material<D> {
     Schema s = isotropic_elastic_schema(true);
     s.real("c", "Pa", "cohesion").required().non_negative();
     s.real("phi", "deg", "friction angle").required().min(0).below(90);
-    s.real("psi", "deg", "dilation angle (non-associated flow; psi <= phi)")
-        .required()
-        .min(0)
-        .below(90);
+    add_dilation_angle(s);
     s.real("tension_cutoff", "Pa",
            "largest principal stress (tension positive); default: the Mohr-Coulomb apex "
            "c/tan(phi), none when phi = 0")
         .non_negative();
-    s.check([](const Params& p, Diagnostics& d) {
-      if (p.real("psi") > p.real("phi"))
-        d.error(p.where("psi"), p.path("psi"),
-                "dilation angle psi = " + format_number(p.real("psi")) +
-                    " must not exceed the friction angle phi = " + format_number(p.real("phi")));
-    });
     return s;
   }
 

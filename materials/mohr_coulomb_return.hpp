@@ -1,6 +1,7 @@
 #pragma once
 // The Mohr-Coulomb principal-stress return mapping shared by the mohr_coulomb and
-// strain_softening_mc materials, and the Jaumann elastic trial both use.
+// strain_softening_mc materials, and what they share with drucker_prager: the Jaumann elastic
+// trial, the reduced friction angle, the dilation angle's schema.
 //
 // Sign convention: Cauchy stress, TENSION POSITIVE. Principal stresses are ordered
 // s1 >= s2 >= s3 (s1 the most tensile, s3 the most compressive). Angles in degrees.
@@ -34,7 +35,9 @@
 #include <functional>
 #include <limits>
 
+#include "framework/diagnostics.hpp"
 #include "framework/material.hpp"
+#include "framework/params.hpp"
 #include "framework/tensor.hpp"
 
 namespace loam {
@@ -43,6 +46,21 @@ namespace loam {
 /// whose tangent is tan(phi) / F, as c / F is the reduced cohesion (Dawson et al. 1999).
 inline double reduced_friction_angle(double phi_deg, double F) {
   return std::atan(std::tan(phi_deg * M_PI / 180.0) / F) * 180.0 / M_PI;
+}
+
+/// The dilation angle `psi` (degrees, 0 <= psi < 90) of a frictional model's schema, and the
+/// located error when it exceeds the friction angle `phi` (mohr_coulomb, drucker_prager).
+inline void add_dilation_angle(Schema& s) {
+  s.real("psi", "deg", "dilation angle (non-associated flow; psi <= phi)")
+      .required()
+      .min(0)
+      .below(90);
+  s.check([](const Params& p, Diagnostics& d) {
+    if (p.real("psi") > p.real("phi"))
+      d.error(p.where("psi"), p.path("psi"),
+              "dilation angle psi = " + format_number(p.real("psi")) +
+                  " must not exceed the friction angle phi = " + format_number(p.real("phi")));
+  });
 }
 
 class MohrCoulombSurface {

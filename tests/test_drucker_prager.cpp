@@ -44,14 +44,9 @@ struct Point : loam_test::MaterialPoint<3> {
     eta = 6 * s / den, xi = 6 * std::cos(rad(phi)) / den;
   }
   double& eqps() { return field(eq); }
-  double mean() { return (stress(0) + stress(1) + stress(2)) / 3; }
-  double sqrt_j2() {
-    const double p = mean();
-    double j2 = 0;
-    for (int k = 0; k < 3; ++k) j2 += 0.5 * (stress(k) - p) * (stress(k) - p);
-    for (int k = 3; k < 6; ++k) j2 += stress(k) * stress(k);
-    return std::sqrt(j2);
-  }
+  /// The cone's variables from MaterialPoint's p (compression positive) and q = sqrt(3 J2).
+  double mean() { return -p(); }
+  double sqrt_j2() { return q() / std::sqrt(3.0); }
   /// f over a stress scale (compression-matched cone).
   double yield() {
     const double scale = xi * c + std::fabs(mean()) + sqrt_j2();

@@ -8,7 +8,8 @@ Usage: aznalcollar_plot.py RUN_DIR --out x.png [--ground 40] [--xlim 60 300] [--
 import argparse
 import csv
 import json
-import re
+import os
+import sys
 
 import h5py
 import matplotlib
@@ -17,22 +18,12 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-
-def frames(run_dir):
-    """(time, file) of every regular frame, from the XDMF index."""
-    with open(f"{run_dir}/particles.xdmf") as f:
-        text = f.read()
-    out = []
-    for grid in re.findall(r"<Grid Name=\"[^\"]*\" GridType=\"Uniform\">(.*?)</Grid>", text, re.S):
-        t = re.search(r'Time Value="([^"]+)"', grid)
-        h5 = re.search(r"([\w.]+\.h5):/position", grid)
-        if t and h5:
-            out.append((float(t.group(1)), h5.group(1)))
-    return out
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from terzaghi_plot import frames  # noqa: E402  ((time, path) of a run's particle frames)
 
 
-def load(run_dir, name):
-    with h5py.File(f"{run_dir}/{name}", "r") as h:
+def load(frame):
+    with h5py.File(frame, "r") as h:
         return h["position"][:, :2], h["plastic_strain_eq"][:], h["displacement"][:, :2]
 
 
@@ -71,7 +62,7 @@ def main():
     for k, st in enumerate(stages):
         ax = fig.add_subplot(grid[k])
         time, name = min(index, key=lambda f: abs(f[0] - st["end_time"]))
-        x, eps, _ = load(a.run_dir, name)
+        x, eps, _ = load(name)
         # Squares about one particle spacing wide (1 m on 2 m cells): points per metre squared.
         size = (8.6 * 72 / (a.xlim[1] - a.xlim[0]) * a.spacing) ** 2
         sc = ax.scatter(x[:, 0], x[:, 1], c=eps, s=size, marker="s", lw=0, cmap="turbo", vmin=0,
@@ -107,7 +98,7 @@ def main():
     fig.savefig(a.out, dpi=a.dpi)
     for st in stages[-2:]:
         time, name = min(index, key=lambda f: abs(f[0] - st["end_time"]))
-        x, eps, _ = load(a.run_dir, name)
+        x, eps, _ = load(name)
         print(f"failure surface at the end of stage '{st['name']}' (t = {time:.1f} s): column "
               "centre x, depth below ground of the largest plastic strain, the strain")
         for xc, depth, e in failure_surface(x, eps, a.ground, a.xlim):
