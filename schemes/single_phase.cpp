@@ -11,10 +11,19 @@
 // particle's current position:
 //   (m v)_I = sum_p m_p N_Ip (v_p + B_p D_p^-1 (x_I - x_p)).
 // D_p comes from the weights: h^2/4 I for interior quadratic B-splines, GIMP's and CPDI's from
-// their domain-averaged weights (invertible: a domain spans nodes). Multilinear tents are
-// refused: there N_Ip D_p^-1 (x_I - x_p) = grad N_Ip (Jiang et al. 2015, section 5.3), which does
-// not vanish with N_Ip, so a node that a particle just reaches gets the full affine momentum on a
-// vanishing mass; a translating bar blew up at its free end's first cell crossing (2026-12-04).
+// their domain-averaged weights (invertible: a domain spans nodes).
+// Multilinear tents are the exception: there N_Ip D_p^-1 (x_I - x_p) = grad N_Ip (Jiang et al.
+// 2015, section 5.3) does not vanish with N_Ip, so a node a particle has just reached carries the
+// affine term on a vanishing mass and an acceleration f_I / m_I that grows as 1 / N_Ip. Measured
+// 2026-12-04 on a bar translating across 0.1 m cells and a spinning disk (tests/test_apic.cpp):
+// B_p D_p^-1 with D_p at the new position, and C_p = sum_I v_I grad N_Ip^T from the updated grid,
+// blew up at the bar's free-end cell crossings (t = 0.25 s, 0.43 s); C_p = the velocity gradient
+// of MUSL's plain re-map damps the disk's rotation away at its free surface (0.2 % per step), and
+// with an affine re-map it blows up. What works: USF, where the particle carries C_p = the
+// velocity gradient of the P2G field (affine part included) at the particle, the gradient the
+// stress update takes; its light nodes hold their points' own affine velocities. So linear tents
+// take APIC with update: usf only (a located error otherwise); angular momentum is then kept
+// only approximately, D_p changing with the position (the tests print the drift).
 // Keeping B_p, not C_p = B_p D_p^-1, and taking D_p where the
 // particle is when it scatters is what conserves angular momentum over the move for weights whose
 // D_p changes with position. Linear and angular momentum are conserved by the transfers; the
@@ -48,17 +57,13 @@ class SinglePhase : public Scheme<D> {
     s.choice("transfer", {"flip", "apic"},
              "particle-grid velocity transfer: flip (the FLIP/PIC blend of `flip`) or apic "
              "(affine particle-in-cell, Jiang et al. 2015: each particle carries an affine "
-             "velocity matrix; no PIC dissipation, no FLIP noise; update: musl)")
+             "velocity matrix; no PIC dissipation, no FLIP noise)")
         .def("flip");
     s.string_list("sets",
                   "names of the particle sets; all are summed onto the one velocity field (e.g. "
                   "a column split into two sets behaves as one), each has its own output frames")
         .def("[particles]");
     s.check([](const Params& p, Diagnostics& d) {
-      if (p.text("transfer") == "apic" && p.text("update") != "musl")
-        d.error(p.where("transfer"), p.path("transfer"),
-                "transfer: apic is implemented for update: musl only (this scheme has update: " +
-                    p.text("update") + ")");
       if (p.text("transfer") == "apic" && p.real("flip") != 1.0)
         d.error(p.where("flip"), p.path("flip"),
                 "flip blends FLIP and PIC; transfer: apic replaces both (remove flip or set it "
@@ -100,7 +105,13 @@ class SinglePhase : public Scheme<D> {
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch&) {});
     if (!apic_) return;
-    affine_ = sim.request_field(affine_moment_info());
+    affine_gradient_ = !sim.shape->stencil_covers_domain();
+    affine_ = sim.request_field(affine_moment_info(affine_gradient_));
+    if (affine_gradient_ && update_ != "usf")
+      diag.error(params_.where("transfer"), params_.path("transfer"),
+                 "transfer: apic with linear tents needs update: usf (C_p is the velocity "
+                 "gradient of the P2G field; with musl or usl the run loses its rotation or "
+                 "blows up: schemes/single_phase.cpp); or use gimp, bspline2 or cpdi");
     node_x_.resize(sim.grid.num_nodes * D);  // node coordinates: x_I - x_p without divisions
     for (size_t n = 0; n < sim.grid.num_nodes; ++n)
       for (int d = 0; d < D; ++d) node_x_[n * D + size_t(d)] = sim.grid.node_coord(n, d);
@@ -109,11 +120,6 @@ class SinglePhase : public Scheme<D> {
                  "transfer: apic handles stencils of up to " + std::to_string(kMaxEntries) +
                      " nodes; this shape function uses " +
                      std::to_string(sim.shape->max_nodes_per_particle()));
-    if (!sim.shape->stencil_covers_domain())
-      diag.error(params_.where("transfer"), params_.path("transfer"),
-                 "transfer: apic needs a shape function whose weights cover the particle's "
-                 "domain (gimp, bspline2, cpdi): with linear tents a node that a particle just "
-                 "reaches gets the full affine momentum on a vanishing mass, and the run blows up");
   }
 
   std::vector<GridFieldView> grid_fields() const override {
@@ -143,8 +149,9 @@ class SinglePhase : public Scheme<D> {
   std::string update_;
   double flip_;
   bool apic_;
-  int affine_ = -1;             // APIC's B_p (D x D, row-major; field affine_moment), or -1
-  std::vector<double> node_x_;  // APIC: node coordinates, num_nodes * D
+  int affine_ = -1;               // APIC's B_p (D x D, row-major; field affine_moment), or -1
+  bool affine_gradient_ = false;  // linear tents: the field holds C_p (see the header)
+  std::vector<double> node_x_;    // APIC: node coordinates, num_nodes * D
   std::vector<std::string> sets_;
   int F_ = -1;                // deformation gradient handle, or -1
   std::vector<double> node_;  // num_nodes * S
@@ -167,17 +174,16 @@ class SinglePhase : public Scheme<D> {
       // particles move with the grid velocity of the update (Sulsky 1995).
       sim.timed("grid", [&] { zero_nodes(vel_, sim.threads); });
       if (apic_)
-        sim.timed("g2p_velocity_remap", [&] {
-          sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-            update_velocity_apic<NPP>(sim, s, b, c, t);
-          });
-        });
+        sim.timed("g2p_velocity_remap", [&] { update_velocities_apic<NPP, true, false>(sim, dt); });
       else
         sim.timed("g2p_velocity_remap", [&] { update_velocities<NPP, true, false>(sim, dt); });
       sim.timed("grid", [&] { momentum_to_velocity(sim, vel_.data(), D, 0); });
       sim.timed("g2p_gradient_stress", [&] { update_stresses<NPP, Gradient::kRemapped>(sim, dt); });
     } else {
-      // USL: gradient, move and velocity update from the updated grid record in one pass.
+      // USL: gradient, move and velocity update from the updated grid record in one pass (APIC:
+      // its G2P first, at the positions before the move; the pass then only moves).
+      if (apic_)
+        sim.timed("g2p_velocity", [&] { update_velocities_apic<NPP, false, false>(sim, dt); });
       sim.timed("g2p_gradient_stress", [&] { update_stresses<NPP, Gradient::kUpdated>(sim, dt); });
     }
     sim.max_speed = max_speed(scratch_);
@@ -193,7 +199,10 @@ class SinglePhase : public Scheme<D> {
     scatter_all<NPP, false, true>(sim);
     update_nodes(sim, dt);
     reset_max_speed(scratch_);
-    update_velocities<NPP, false, true>(sim, dt);
+    if (apic_)
+      update_velocities_apic<NPP, false, true>(sim, dt);
+    else
+      update_velocities<NPP, false, true>(sim, dt);
     sim.max_speed = max_speed(scratch_);
   }
 
@@ -218,11 +227,23 @@ class SinglePhase : public Scheme<D> {
     else
       sim.gather_blocks(f);
   }
+  /// APIC's G2P (update_velocity_apic), REMAP and MOVE as in update_velocities.
+  template <int NPP, bool REMAP, bool MOVE>
+  void update_velocities_apic(Simulation<D>& sim, double dt) {
+    auto f = [&](ParticleSet<D>& s, size_t b, int c, int t) {
+      update_velocity_apic<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
+    };
+    if constexpr (REMAP)
+      sim.scatter_blocks(f);
+    else
+      sim.gather_blocks(f);
+  }
   /// What the gradient pass does besides the velocity gradient, volume and stress update.
   enum class Gradient {
     kRemapped,  // MUSL: L from the re-mapped velocity vel_; move with the updated grid velocity
     kCurrent,   // USF: L from vel_ (velocity at t^n); particles do not move here
     kUpdated,   // USL: L, move and FLIP update all from the updated grid record, in one pass
+                // (with APIC the velocities are already updated: L and move only)
   };
   template <int NPP, Gradient MODE>
   void update_stresses(Simulation<D>& sim, double dt) {
@@ -268,7 +289,7 @@ class SinglePhase : public Scheme<D> {
           for (int j = 0; j < D; ++j) B[d][j] = P.col(affine_, d * D + j)[b + size_t(p)];
         }
         affine_stencil(st, p, npp, xp, as);
-        affine_matrix(mp, B, as.inertia, mC);
+        affine_matrix(mp, B, as, mC);
       }
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -418,18 +439,24 @@ class SinglePhase : public Scheme<D> {
       const size_t kp = size_t(k) * kBlock + size_t(p);
       const double* xI = node_x_.data() + size_t(st.node[kp]) * D;
       for (int d = 0; d < D; ++d) a.dx[k][d] = xI[d] - xp[d];
+      if (affine_gradient_) continue;  // C_p needs no inertia
       for (int d = 0; d < D; ++d)
         for (int j = 0; j < D; ++j) a.inertia(d, j) += st.w[kp] * a.dx[k][d] * a.dx[k][j];
     }
   }
 
-  /// mC = m_p B_p D_p^-1, B given row-major.
-  static void affine_matrix(double mp, const double (&B)[D][D],
-                            const Eigen::Matrix<double, D, D>& inertia, double (&mC)[D][D]) {
+  /// mC = m_p B_p D_p^-1, B given row-major; m_p C_p with linear tents (the field holds C_p).
+  void affine_matrix(double mp, const double (&B)[D][D], const AffineStencil& as,
+                     double (&mC)[D][D]) const {
+    if (affine_gradient_) {
+      for (int d = 0; d < D; ++d)
+        for (int j = 0; j < D; ++j) mC[d][j] = mp * B[d][j];
+      return;
+    }
     Eigen::Matrix<double, D, D> Bm;
     for (int d = 0; d < D; ++d)
       for (int j = 0; j < D; ++j) Bm(d, j) = mp * B[d][j];
-    const Eigen::Matrix<double, D, D> C = Bm * inertia.inverse();
+    const Eigen::Matrix<double, D, D> C = Bm * as.inertia.inverse();
     for (int d = 0; d < D; ++d)
       for (int j = 0; j < D; ++j) mC[d][j] = C(d, j);
   }
@@ -445,10 +472,10 @@ class SinglePhase : public Scheme<D> {
   }
 
   /// APIC grid-to-particle update of one block (the header's equations) from the updated grid
-  /// velocities, and the MUSL re-map of the new particle momenta, affine part included, into
-  /// vel_.
-  template <int NPP>
-  void update_velocity_apic(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count,
+  /// velocities; with REMAP the MUSL re-map of the new particle momenta, affine part included,
+  /// into vel_; with MOVE the move (after B_p is taken at the old position).
+  template <int NPP, bool REMAP, bool MOVE>
+  void update_velocity_apic(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
                             int thread) {
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
@@ -457,6 +484,7 @@ class SinglePhase : public Scheme<D> {
     const int npp = NPP ? NPP : st.npp;
     const double* g = node_.data();
     double* remap = vel_.data();
+    const HeldFaces<D> walls = sim.held_faces;
     double max_v2 = sc.max_v2;
     AffineStencil as;
     for (int p = 0; p < count; ++p) {
@@ -468,10 +496,10 @@ class SinglePhase : public Scheme<D> {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
         const double* vI = g + size_t(st.node[kp]) * S + kMomentum;
-        for (int d = 0; d < D; ++d) {
-          vp[d] += w * vI[d];
-          for (int j = 0; j < D; ++j) B[d][j] += w * vI[d] * as.dx[k][j];
-        }
+        for (int d = 0; d < D; ++d) vp[d] += w * vI[d];
+        if (!affine_gradient_)  // B_p = sum_I N_Ip v_I (x_I - x_p)^T (C_p: the gradient pass)
+          for (int d = 0; d < D; ++d)
+            for (int j = 0; j < D; ++j) B[d][j] += w * vI[d] * as.dx[k][j];
       }
       double v2 = 0, mv[D], mC[D][D];
       const double mp = P.col(P.mass)[i];
@@ -479,10 +507,13 @@ class SinglePhase : public Scheme<D> {
         P.col(P.velocity, d)[i] = vp[d];
         mv[d] = mp * vp[d];
         v2 += vp[d] * vp[d];
-        for (int j = 0; j < D; ++j) P.col(affine_, d * D + j)[i] = B[d][j];
+        if (!affine_gradient_)  // linear tents: the USF gradient pass stores C_p
+          for (int j = 0; j < D; ++j) P.col(affine_, d * D + j)[i] = B[d][j];
+        if constexpr (MOVE) P.col(P.position, d)[i] = walls.moved(d, xp[d], dt * vp[d]);
       }
       max_v2 = std::max(max_v2, v2);
-      affine_matrix(mp, B, as.inertia, mC);
+      if constexpr (!REMAP) continue;
+      affine_matrix(mp, B, as, mC);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         double a[D];
@@ -494,10 +525,15 @@ class SinglePhase : public Scheme<D> {
     sc.max_v2 = max_v2;
   }
 
-  static FieldInfo affine_moment_info() {
+  static FieldInfo affine_moment_info(bool gradient) {
     std::vector<std::string> names;
     for (int i = 0; i < D; ++i)
       for (int j = 0; j < D; ++j) names.push_back(std::string(1, "xyz"[i]) + "xyz"[j]);
+    if (gradient)
+      return {"affine_moment", D * D, "1/s",
+              "APIC with linear tents (update: usf): C_p, the velocity gradient of the P2G field "
+              "at the particle; the particle's velocity field is v_p + C_p (x - x_p)",
+              names};
     return {"affine_moment", D * D, "m^2/s",
             "APIC's B_p = sum_I N_Ip v_I (x_I - x_p)^T (Jiang et al. 2015): with the inertia D_p "
             "the particle's velocity field is v_p + B_p D_p^-1 (x - x_p)",
@@ -529,6 +565,7 @@ class SinglePhase : public Scheme<D> {
     const double* vel = kFromRecord ? node_.data() + kMomentum : vel_.data();
     const size_t vstride = kFromRecord ? S : D;
     const double flip = flip_;
+    const bool apic = apic_;  // USL with APIC: the velocities are updated already
     const HeldFaces<D> walls = sim.held_faces;
     double max_v2 = sc.max_v2;
     for (int p = 0; p < count; ++p) {
@@ -545,10 +582,13 @@ class SinglePhase : public Scheme<D> {
         }
       }
       store_velocity_gradient<D>(l, L, p);
+      if (MODE == Gradient::kCurrent && affine_gradient_)  // linear tents' C_p (the header)
+        for (int d = 0; d < D; ++d)
+          for (int j = 0; j < D; ++j) P.col(affine_, d * D + j)[b + size_t(p)] = l[d][j];
       update_volume_and_deformation<D>(l, dt, V[p], F, p);
       if constexpr (kMove)
         for (int d = 0; d < D; ++d) x[size_t(d)][p] = walls.moved(d, x[size_t(d)][p], dt * vn[d]);
-      if constexpr (kFromRecord) {
+      if (kFromRecord && !apic) {
         double v2 = 0;
         for (int d = 0; d < D; ++d) {
           double& vp = v[size_t(d)][p];

@@ -8,6 +8,27 @@ import math
 import sys
 
 
+def flow_map(text):
+    """A flat flow map as `loam compare` writes a map-valued axis ('{a: 1, b: x}'), or None."""
+    t = text.strip()
+    if not (t.startswith("{") and t.endswith("}")):
+        return None
+    pairs = [p.split(":", 1) for p in t[1:-1].split(",") if p.strip()]
+    if any(len(p) != 2 for p in pairs):
+        return None
+    return {k.strip(): v.strip() for k, v in pairs}
+
+
+def short_labels(values):
+    """Series labels: a map-valued axis is named by the keys that differ between its values."""
+    maps = {v: flow_map(v) for v in values}
+    if not values or any(m is None for m in maps.values()):
+        return {v: v for v in values}
+    keys = sorted({k for m in maps.values() for k in m})
+    differ = [k for k in keys if len({maps[v].get(k) for v in values}) > 1]
+    return {v: ", ".join(f"{k}: {maps[v][k]}" for k in differ if k in maps[v]) or v for v in values}
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("csv")
@@ -38,9 +59,11 @@ def main():
     if not pts:
         sys.exit("no successful variant with a positive error")
     fig, ax = plt.subplots(figsize=(7, 5))
-    for name in sorted({p[2] for p in pts}):
+    names = sorted({p[2] for p in pts})
+    labels = short_labels(names)
+    for name in names:
         s = sorted((p for p in pts if p[2] == name), key=lambda p: p[0])
-        ax.plot([p[0] for p in s], [p[1] for p in s], "o-", label=name, alpha=0.8)
+        ax.plot([p[0] for p in s], [p[1] for p in s], "o-", label=labels[name], alpha=0.8)
     # Pareto front: sorted by time, keep points that improve on the best error so far.
     front, best = [], float("inf")
     for p in sorted(pts, key=lambda p: (p[0], p[1])):

@@ -65,6 +65,8 @@ class GranularCollapse : public Reference<D> {
     m["height_ratio"] = m["final_height"] / L0_;  // H_f/L0
     m["lube2005_runout_ratio"] = lube_runout(a);
     m["lube2005_height_ratio"] = a < 1.15 ? a : std::pow(a, 0.4);
+    // |(L_f - L0)/L0 / Lube's - 1|: the error `loam compare` plots against wall time.
+    m["runout_error"] = std::fabs(m["runout_ratio"] / m["lube2005_runout_ratio"] - 1);
     m["max_speed_final"] = std::sqrt(v2);
     return m;
   }
