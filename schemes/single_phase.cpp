@@ -3,38 +3,16 @@
 // force computation (USF), after the grid update (USL), or after re-mapping the updated particle
 // momentum to the grid (MUSL, the default; least noisy for near-empty nodes).
 //
-// `transfer: apic` (MUSL): the affine particle-in-cell transfer of Jiang et al. (2015). Each
-// particle carries the velocity's first moment about it, B_p (field affine_moment). G2P from the
-// updated grid velocities v_I, at the particle's position before the move:
-//   v_p = sum_I N_Ip v_I,   B_p = sum_I N_Ip v_I (x_I - x_p)^T;
-// P2G (and the MUSL re-map), with the inertia D_p = sum_I N_Ip (x_I - x_p)(x_I - x_p)^T of the
-// particle's current position:
-//   (m v)_I = sum_p m_p N_Ip (v_p + B_p D_p^-1 (x_I - x_p)).
-// D_p comes from the weights: h^2/4 I for interior quadratic B-splines, GIMP's and CPDI's from
-// their domain-averaged weights (invertible: a domain spans nodes).
-// Multilinear tents are the exception: there N_Ip D_p^-1 (x_I - x_p) = grad N_Ip (Jiang et al.
-// 2015, section 5.3) does not vanish with N_Ip, so a node a particle has just reached carries the
-// affine term on a vanishing mass and an acceleration f_I / m_I that grows as 1 / N_Ip. Measured
-// 2026-12-04 on a bar translating across 0.1 m cells and a spinning disk (tests/test_apic.cpp):
-// B_p D_p^-1 with D_p at the new position, and C_p = sum_I v_I grad N_Ip^T from the updated grid,
-// blew up at the bar's free-end cell crossings (t = 0.25 s, 0.43 s); C_p = the velocity gradient
-// of MUSL's plain re-map damps the disk's rotation away at its free surface (0.2 % per step), and
-// with an affine re-map it blows up. What works: USF, where the particle carries C_p = the
-// velocity gradient of the P2G field (affine part included) at the particle, the gradient the
-// stress update takes; its light nodes hold their points' own affine velocities. So linear tents
-// take APIC with update: usf only (a located error otherwise); angular momentum is then kept
-// only approximately, D_p changing with the position (the tests print the drift).
-// Keeping B_p, not C_p = B_p D_p^-1, and taking D_p where the
-// particle is when it scatters is what conserves angular momentum over the move for weights whose
-// D_p changes with position. Linear and angular momentum are conserved by the transfers; the
-// affine part carries no PIC dissipation and no FLIP noise (tests/test_apic.cpp).
+// `transfer: apic`: the affine particle-in-cell transfer of Jiang et al. (2015) with every
+// update variant (framework/affine_transfer.hpp has the equations and why linear tents take it
+// with update: usf only); the field affine_moment holds B_p (C_p with linear tents).
 #include <omp.h>
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <memory>
 
+#include "framework/affine_transfer.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 #include "framework/step_blocks.hpp"
@@ -53,21 +31,12 @@ class SinglePhase : public Scheme<D> {
              "when stress is updated: musl (after re-mapping particle momentum), usl (after the "
              "grid update), usf (before forces)")
         .def("musl");
-    add_flip_param(s);
-    s.choice("transfer", {"flip", "apic"},
-             "particle-grid velocity transfer: flip (the FLIP/PIC blend of `flip`) or apic "
-             "(affine particle-in-cell, Jiang et al. 2015: each particle carries an affine "
-             "velocity matrix; no PIC dissipation, no FLIP noise)")
-        .def("flip");
+    add_transfer_params(s, "; with linear tents update: usf");
     s.string_list("sets",
                   "names of the particle sets; all are summed onto the one velocity field (e.g. "
                   "a column split into two sets behaves as one), each has its own output frames")
         .def("[particles]");
     s.check([](const Params& p, Diagnostics& d) {
-      if (p.text("transfer") == "apic" && p.real("flip") != 1.0)
-        d.error(p.where("flip"), p.path("flip"),
-                "flip blends FLIP and PIC; transfer: apic replaces both (remove flip or set it "
-                "to 1)");
       const auto& names = p.strings("sets");
       if (names.empty()) d.error(p.where("sets"), p.path("sets"), "give at least one set");
       for (size_t i = 0; i < names.size(); ++i) {
@@ -105,19 +74,17 @@ class SinglePhase : public Scheme<D> {
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch&) {});
     if (!apic_) return;
-    affine_gradient_ = !sim.shape->stencil_covers_domain();
-    affine_ = sim.request_field(affine_moment_info(affine_gradient_));
-    if (affine_gradient_ && update_ != "usf")
+    affine_.setup(sim.grid, *sim.shape);
+    B_ = sim.request_field(affine_.field_info("affine_moment", "velocity"));
+    if (affine_.gradient_form() && update_ != "usf")
       diag.error(params_.where("transfer"), params_.path("transfer"),
                  "transfer: apic with linear tents needs update: usf (C_p is the velocity "
                  "gradient of the P2G field; with musl or usl the run loses its rotation or "
-                 "blows up: schemes/single_phase.cpp); or use gimp, bspline2 or cpdi");
-    node_x_.resize(sim.grid.num_nodes * D);  // node coordinates: x_I - x_p without divisions
-    for (size_t n = 0; n < sim.grid.num_nodes; ++n)
-      for (int d = 0; d < D; ++d) node_x_[n * D + size_t(d)] = sim.grid.node_coord(n, d);
-    if (sim.shape->max_nodes_per_particle() > kMaxEntries)
+                 "blows up: framework/affine_transfer.hpp); or use gimp, bspline2 or cpdi");
+    if (!AffineTransfer<D>::fits(*sim.shape))
       diag.error(params_.where("transfer"), params_.path("transfer"),
-                 "transfer: apic handles stencils of up to " + std::to_string(kMaxEntries) +
+                 "transfer: apic handles stencils of up to " +
+                     std::to_string(AffineTransfer<D>::kMaxEntries) +
                      " nodes; this shape function uses " +
                      std::to_string(sim.shape->max_nodes_per_particle()));
   }
@@ -149,9 +116,8 @@ class SinglePhase : public Scheme<D> {
   std::string update_;
   double flip_;
   bool apic_;
-  int affine_ = -1;               // APIC's B_p (D x D, row-major; field affine_moment), or -1
-  bool affine_gradient_ = false;  // linear tents: the field holds C_p (see the header)
-  std::vector<double> node_x_;    // APIC: node coordinates, num_nodes * D
+  int B_ = -1;                // APIC's B_p (D x D, row-major; field affine_moment), or -1
+  AffineTransfer<D> affine_;  // APIC's per-entry algebra (framework/affine_transfer.hpp)
   std::vector<std::string> sets_;
   int F_ = -1;                // deformation gradient handle, or -1
   std::vector<double> node_;  // num_nodes * S
@@ -271,8 +237,8 @@ class SinglePhase : public Scheme<D> {
     for (int c = 0; c < NS; ++c) sig[size_t(c)] = P.col(P.stress, c) + b;
     double* g = node_.data();
     const std::array<double, D> gravity = sim.gravity;
-    const bool affine = MOMENTUM && affine_ >= 0;
-    AffineStencil as;
+    const bool affine = MOMENTUM && B_ >= 0;
+    typename AffineTransfer<D>::Stencil as;
     for (int p = 0; p < count; ++p) {
       // Particle values in locals: the node stores below could alias the particle columns.
       const double mp = m[p];
@@ -286,10 +252,10 @@ class SinglePhase : public Scheme<D> {
         double B[D][D];
         for (int d = 0; d < D; ++d) {
           xp[d] = P.col(P.position, d)[b + size_t(p)];
-          for (int j = 0; j < D; ++j) B[d][j] = P.col(affine_, d * D + j)[b + size_t(p)];
+          for (int j = 0; j < D; ++j) B[d][j] = P.col(B_, d * D + j)[b + size_t(p)];
         }
-        affine_stencil(st, p, npp, xp, as);
-        affine_matrix(mp, B, as, mC);
+        affine_.stencil(st, p, npp, xp, as);
+        affine_.matrix(mp, B, as, mC);
       }
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -299,7 +265,7 @@ class SinglePhase : public Scheme<D> {
           r[kMass] += w * mp;
           if (affine) {  // APIC: m_p (N v_p + B_p D_p^-1 N (x_I - x_p)), see the header
             double a[D];
-            affine_momentum(w, as.dx[k], mv, mC, a);
+            affine_.momentum(w, as.dx[k], mv, mC, a);
             for (int d = 0; d < D; ++d) r[kMomentum + d] += a[d];
           } else {
             for (int d = 0; d < D; ++d) r[kMomentum + d] += w * mv[d];
@@ -425,52 +391,6 @@ class SinglePhase : public Scheme<D> {
     sc.max_v2 = max_v2;
   }
 
-  /// Entries of a stencil APIC handles per particle (CPDI's widest, 4^D).
-  static constexpr int kMaxEntries = ipow(4, D);
-  /// x_I - x_p of every stencil entry of particle p (position xp), and D_p's accumulation.
-  struct AffineStencil {
-    double dx[kMaxEntries][D];
-    Eigen::Matrix<double, D, D> inertia;
-  };
-  void affine_stencil(const StencilBlock<D>& st, int p, int npp, const double* xp,
-                      AffineStencil& a) const {
-    a.inertia.setZero();
-    for (int k = 0; k < npp; ++k) {
-      const size_t kp = size_t(k) * kBlock + size_t(p);
-      const double* xI = node_x_.data() + size_t(st.node[kp]) * D;
-      for (int d = 0; d < D; ++d) a.dx[k][d] = xI[d] - xp[d];
-      if (affine_gradient_) continue;  // C_p needs no inertia
-      for (int d = 0; d < D; ++d)
-        for (int j = 0; j < D; ++j) a.inertia(d, j) += st.w[kp] * a.dx[k][d] * a.dx[k][j];
-    }
-  }
-
-  /// mC = m_p B_p D_p^-1, B given row-major; m_p C_p with linear tents (the field holds C_p).
-  void affine_matrix(double mp, const double (&B)[D][D], const AffineStencil& as,
-                     double (&mC)[D][D]) const {
-    if (affine_gradient_) {
-      for (int d = 0; d < D; ++d)
-        for (int j = 0; j < D; ++j) mC[d][j] = mp * B[d][j];
-      return;
-    }
-    Eigen::Matrix<double, D, D> Bm;
-    for (int d = 0; d < D; ++d)
-      for (int j = 0; j < D; ++j) Bm(d, j) = mp * B[d][j];
-    const Eigen::Matrix<double, D, D> C = Bm * as.inertia.inverse();
-    for (int d = 0; d < D; ++d)
-      for (int j = 0; j < D; ++j) mC[d][j] = C(d, j);
-  }
-
-  /// The momentum stencil entry k sends to its node: w (m v_p + (m B D^-1)(x_I - x_p)).
-  static void affine_momentum(double w, const double* dx, const double (&mv)[D],
-                              const double (&mC)[D][D], double (&out)[D]) {
-    for (int d = 0; d < D; ++d) {
-      double a = mv[d];
-      for (int j = 0; j < D; ++j) a += mC[d][j] * dx[j];
-      out[d] = w * a;
-    }
-  }
-
   /// APIC grid-to-particle update of one block (the header's equations) from the updated grid
   /// velocities; with REMAP the MUSL re-map of the new particle momenta, affine part included,
   /// into vel_; with MOVE the move (after B_p is taken at the old position).
@@ -486,20 +406,18 @@ class SinglePhase : public Scheme<D> {
     double* remap = vel_.data();
     const HeldFaces<D> walls = sim.held_faces;
     double max_v2 = sc.max_v2;
-    AffineStencil as;
+    typename AffineTransfer<D>::Stencil as;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       double xp[D], vp[D] = {}, B[D][D] = {};
       for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
-      affine_stencil(st, p, npp, xp, as);
+      affine_.stencil(st, p, npp, xp, as);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
         const double* vI = g + size_t(st.node[kp]) * S + kMomentum;
         for (int d = 0; d < D; ++d) vp[d] += w * vI[d];
-        if (!affine_gradient_)  // B_p = sum_I N_Ip v_I (x_I - x_p)^T (C_p: the gradient pass)
-          for (int d = 0; d < D; ++d)
-            for (int j = 0; j < D; ++j) B[d][j] += w * vI[d] * as.dx[k][j];
+        affine_.add_moment(w, vI, as.dx[k], B);
       }
       double v2 = 0, mv[D], mC[D][D];
       const double mp = P.col(P.mass)[i];
@@ -507,37 +425,22 @@ class SinglePhase : public Scheme<D> {
         P.col(P.velocity, d)[i] = vp[d];
         mv[d] = mp * vp[d];
         v2 += vp[d] * vp[d];
-        if (!affine_gradient_)  // linear tents: the USF gradient pass stores C_p
-          for (int j = 0; j < D; ++j) P.col(affine_, d * D + j)[i] = B[d][j];
+        if (!affine_.gradient_form())  // linear tents: the USF gradient pass stores C_p
+          for (int j = 0; j < D; ++j) P.col(B_, d * D + j)[i] = B[d][j];
         if constexpr (MOVE) P.col(P.position, d)[i] = walls.moved(d, xp[d], dt * vp[d]);
       }
       max_v2 = std::max(max_v2, v2);
       if constexpr (!REMAP) continue;
-      affine_matrix(mp, B, as, mC);
+      affine_.matrix(mp, B, as, mC);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         double a[D];
-        affine_momentum(st.w[kp], as.dx[k], mv, mC, a);
+        affine_.momentum(st.w[kp], as.dx[k], mv, mC, a);
         double* r = remap + size_t(st.node[kp]) * D;
         for (int d = 0; d < D; ++d) r[d] += a[d];
       }
     }
     sc.max_v2 = max_v2;
-  }
-
-  static FieldInfo affine_moment_info(bool gradient) {
-    std::vector<std::string> names;
-    for (int i = 0; i < D; ++i)
-      for (int j = 0; j < D; ++j) names.push_back(std::string(1, "xyz"[i]) + "xyz"[j]);
-    if (gradient)
-      return {"affine_moment", D * D, "1/s",
-              "APIC with linear tents (update: usf): C_p, the velocity gradient of the P2G field "
-              "at the particle; the particle's velocity field is v_p + C_p (x - x_p)",
-              names};
-    return {"affine_moment", D * D, "m^2/s",
-            "APIC's B_p = sum_I N_Ip v_I (x_I - x_p)^T (Jiang et al. 2015): with the inertia D_p "
-            "the particle's velocity field is v_p + B_p D_p^-1 (x - x_p)",
-            names};
   }
 
   /// Velocity gradient, volume and F update, optional move / velocity update, and the
@@ -582,9 +485,9 @@ class SinglePhase : public Scheme<D> {
         }
       }
       store_velocity_gradient<D>(l, L, p);
-      if (MODE == Gradient::kCurrent && affine_gradient_)  // linear tents' C_p (the header)
+      if (MODE == Gradient::kCurrent && B_ >= 0 && affine_.gradient_form())  // linear: C_p
         for (int d = 0; d < D; ++d)
-          for (int j = 0; j < D; ++j) P.col(affine_, d * D + j)[b + size_t(p)] = l[d][j];
+          for (int j = 0; j < D; ++j) P.col(B_, d * D + j)[b + size_t(p)] = l[d][j];
       update_volume_and_deformation<D>(l, dt, V[p], F, p);
       if constexpr (kMove)
         for (int d = 0; d < D; ++d) x[size_t(d)][p] = walls.moved(d, x[size_t(d)][p], dt * vn[d]);

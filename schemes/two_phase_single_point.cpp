@@ -30,7 +30,10 @@
 //      condition may couple the phases or apply implicit forces (e.g. absorbing dashpots). A
 //      phase left free where its partner was held (fixed + drained) is then solved again
 //      against the held velocity (follow_held_phase).
-//   3. grid -> particle: FLIP/PIC update of v and w from the grid accelerations. `update: musl`
+//   3. grid -> particle: FLIP/PIC update of v and w from the grid accelerations, or with
+//      `transfer: apic` the affine transfer of both phases (each particle carries B_p of v and of
+//      w, fields affine_moment and water_affine_moment; framework/affine_transfer.hpp), whose
+//      P2G in step 1 then scatters the affine momenta. `update: musl`
 //      (default) re-maps the new particle momenta of both phases to the grid (Sulsky 1995)
 //      with the particles still at x^n, takes the gradients below from those velocities on the
 //      same stencil, then moves the particles with the solid grid velocity; `update: usl` takes
@@ -55,6 +58,7 @@
 #include <cmath>
 #include <memory>
 
+#include "framework/affine_transfer.hpp"
 #include "framework/cell_sums.hpp"
 #include "framework/drag.hpp"
 #include "framework/registry.hpp"
@@ -93,7 +97,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
              "particle-to-particle pressure checkerboard that appears once particles cross "
              "cells); none: every particle keeps its own pressure")
         .def("cell");
-    add_flip_param(s);
+    add_transfer_params(s, "; gimp, bspline2 or cpdi");
     return s;
   }
   explicit TwoPhaseSinglePoint(const Params& p)
@@ -102,6 +106,9 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         Kw_(p.real("water_bulk_modulus")),
         flip_(p.real("flip")),
         musl_(p.text("update") == "musl"),
+        apic_(p.text("transfer") == "apic"),
+        transfer_where_(p.where("transfer")),
+        transfer_path_(p.path("transfer")),
         smooth_(p.text("pressure_smoothing") == "cell") {}
 
   int phases() const override { return 2; }
@@ -129,6 +136,20 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     if (musl_) remap_.assign(sim.grid.num_nodes * 2 * D, 0.0);
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
+    if (apic_) setup_apic(sim, diag);
+  }
+
+  /// transfer: apic: B_p fields of both phases. Linear tents need USF's gradient (see
+  /// framework/affine_transfer.hpp), which this scheme does not have: refused.
+  void setup_apic(Simulation<D>& sim, Diagnostics& diag) {
+    affine_.setup(sim.grid, *sim.shape);
+    Bs_ = sim.request_field(affine_.field_info("affine_moment", "solid velocity"));
+    Bw_ = sim.request_field(affine_.field_info("water_affine_moment", "water velocity"));
+    if (affine_.gradient_form() || !AffineTransfer<D>::fits(*sim.shape))
+      diag.error(transfer_where_, transfer_path_,
+                 "transfer: apic in this scheme needs gimp, bspline2 or cpdi (linear tents take "
+                 "APIC with update: usf only, which this scheme does not offer: "
+                 "framework/affine_transfer.hpp)");
   }
 
   /// Porosity n0, solid mass (1 - n0) rho_s V (the material density is rho_s), water velocity
@@ -238,6 +259,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   std::unique_ptr<Drag<D>> drag_;
   double n0_, Kw_, flip_, rho_w_ = 1000;
   bool musl_;
+  bool apic_;
+  Location transfer_where_;  // for set-up errors about `transfer`
+  std::string transfer_path_;
+  int Bs_ = -1, Bw_ = -1;     // APIC: B_p of the solid and the water velocity, or -1
+  AffineTransfer<D> affine_;  // APIC's per-entry algebra
+  using AffineStencil = typename AffineTransfer<D>::Stencil;
   std::vector<double> remap_;  // MUSL: per node solid then water velocity (2 D values)
   int w_ = -1, n_ = -1, p_ = -1, F_ = -1;
   std::vector<double> node_;
@@ -286,6 +313,23 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     }
   }
 
+  /// APIC: particle i's stencil geometry and m B D^-1 of both phases (solid mass ms, water mw).
+  void affine_matrices(Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
+                       double ms, double mw, AffineStencil& as, double (&mCs)[D][D],
+                       double (&mCw)[D][D]) const {
+    double xp[D], Bs[D][D], Bw[D][D];
+    for (int d = 0; d < D; ++d) {
+      xp[d] = P.col(P.position, d)[i];
+      for (int j = 0; j < D; ++j) {
+        Bs[d][j] = P.col(Bs_, d * D + j)[i];
+        Bw[d][j] = P.col(Bw_, d * D + j)[i];
+      }
+    }
+    affine_.stencil(st, p, npp, xp, as);
+    affine_.matrix(ms, Bs, as, mCs);
+    affine_.matrix(mw, Bw, as, mCw);
+  }
+
   template <int NPP>
   void scatter(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
     Particles<D>& P = set.particles;
@@ -310,10 +354,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       }
     drag_->coefficient(size_t(count), n, drag_->speed_dependent() ? speed : nullptr, sc.Q.data());
     double* g = node_.data();
+    AffineStencil as;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       const double mw = n[p] * rho_w_ * V[p];
-      double vs[D], vw[D], body[D], sv[D][D];
+      double vs[D], vw[D], body[D], sv[D][D], mCs[D][D] = {}, mCw[D][D] = {};
+      if (apic_) affine_matrices(P, st, p, i, npp, ms[p], mw, as, mCs, mCw);
       for (int d = 0; d < D; ++d) {
         vs[d] = P.col(P.velocity, d)[i];
         vw[d] = P.col(w_, d)[i];
@@ -334,9 +380,24 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         double gr[D];
         for (int j = 0; j < D; ++j)
           gr[j] = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
+        double ps[D], pw_[D];  // the phases' momenta this entry sends (APIC: affine)
+        if (apic_) {
+          double msv[D], mwv[D];
+          for (int d = 0; d < D; ++d) {
+            msv[d] = ms[p] * vs[d];
+            mwv[d] = mw * vw[d];
+          }
+          AffineTransfer<D>::momentum(w, as.dx[k], msv, mCs, ps);
+          AffineTransfer<D>::momentum(w, as.dx[k], mwv, mCw, pw_);
+        } else {
+          for (int d = 0; d < D; ++d) {
+            ps[d] = w * ms[p] * vs[d];
+            pw_[d] = w * mw * vw[d];
+          }
+        }
         for (int d = 0; d < D; ++d) {
-          r[kV + d] += w * ms[p] * vs[d];
-          r[kW + d] += w * mw * vw[d];
+          r[kV + d] += ps[d];
+          r[kW + d] += pw_[d];
           double f = w * body[d];
           for (int j = 0; j < D; ++j) f -= sv[d][j] * gr[j];
           r[kF + d] += f;
@@ -448,16 +509,42 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     sim.shape->evaluate(sim.grid, P, b, count, st);
     const int npp = NPP ? NPP : st.npp;
     double max_v2 = sc.max_v2;
+    AffineStencil as;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      max_v2 = std::max(max_v2, velocity_update<false>(sim, P, st, p, i, npp, dt, &move_[i * D]));
+      max_v2 = std::max(max_v2, velocity_update<false>(sim, P, st, p, i, npp, dt, &move_[i * D],
+                                                       apic_ ? &as : nullptr));
       const double ms = P.col(P.mass)[i], mw = P.col(n_)[i] * rho_w_ * P.col(P.volume)[i];
+      double msv[D] = {}, mwv[D] = {}, mCs[D][D] = {}, mCw[D][D] = {};
+      if (apic_) {  // the re-map carries the affine momenta, with D_p at x^n (as the scatter)
+        double Bs[D][D], Bw[D][D];
+        for (int d = 0; d < D; ++d) {
+          msv[d] = ms * P.col(P.velocity, d)[i];
+          mwv[d] = mw * P.col(w_, d)[i];
+          for (int j = 0; j < D; ++j) {
+            Bs[d][j] = P.col(Bs_, d * D + j)[i];
+            Bw[d][j] = P.col(Bw_, d * D + j)[i];
+          }
+        }
+        affine_.matrix(ms, Bs, as, mCs);
+        affine_.matrix(mw, Bw, as, mCw);
+      }
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         double* r = remap_.data() + size_t(st.node[kp]) * 2 * D;
-        for (int d = 0; d < D; ++d) {
-          r[d] += st.w[kp] * ms * P.col(P.velocity, d)[i];
-          r[D + d] += st.w[kp] * mw * P.col(w_, d)[i];
+        if (apic_) {
+          double ps[D], pw[D];
+          AffineTransfer<D>::momentum(st.w[kp], as.dx[k], msv, mCs, ps);
+          AffineTransfer<D>::momentum(st.w[kp], as.dx[k], mwv, mCw, pw);
+          for (int d = 0; d < D; ++d) {
+            r[d] += ps[d];
+            r[D + d] += pw[d];
+          }
+        } else {
+          for (int d = 0; d < D; ++d) {
+            r[d] += st.w[kp] * ms * P.col(P.velocity, d)[i];
+            r[D + d] += st.w[kp] * mw * P.col(w_, d)[i];
+          }
         }
       }
     }
@@ -483,11 +570,19 @@ class TwoPhaseSinglePoint : public Scheme<D> {
 
   /// Particle p (index i) of a block: FLIP/PIC update of v and w from the grid record and its
   /// move dt v_grid with the solid grid velocity: done now with MOVE (kept inside the held
-  /// faces), else stored in `move` (D values) for the gradient pass; returns |v|^2.
+  /// faces), else stored in `move` (D values) for the gradient pass; returns |v|^2. With APIC
+  /// (`as` given): v and w from the grid velocities and both B_p, taken at x^n before the move
+  /// (framework/affine_transfer.hpp), `as` left holding the stencil geometry there.
   template <bool MOVE>
   double velocity_update(const Simulation<D>& sim, Particles<D>& P, const StencilBlock<D>& st,
-                         int p, size_t i, int npp, double dt, double* move = nullptr) {
-    double vn[D] = {}, wn[D] = {}, as[D] = {}, aw[D] = {};
+                         int p, size_t i, int npp, double dt, double* move = nullptr,
+                         AffineStencil* as = nullptr) {
+    double vn[D] = {}, wn[D] = {}, acc_s[D] = {}, acc_w[D] = {}, Bs[D][D] = {}, Bw[D][D] = {};
+    if (as) {
+      double xp[D];
+      for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
+      affine_.stencil(st, p, npp, xp, *as);
+    }
     for (int k = 0; k < npp; ++k) {
       const size_t kp = size_t(k) * kBlock + size_t(p);
       const double w = st.w[kp];
@@ -495,16 +590,29 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       for (int d = 0; d < D; ++d) {
         vn[d] += w * r[kV + d];
         wn[d] += w * r[kW + d];
-        as[d] += w * r[kF + d];
-        aw[d] += w * r[kFw + d];
+        acc_s[d] += w * r[kF + d];
+        acc_w[d] += w * r[kFw + d];
+      }
+      if (as) {
+        affine_.add_moment(w, r + kV, as->dx[k], Bs);
+        affine_.add_moment(w, r + kW, as->dx[k], Bw);
       }
     }
     double v2 = 0;
     for (int d = 0; d < D; ++d) {
       double& v = P.col(P.velocity, d)[i];
       double& w = P.col(w_, d)[i];
-      v = flip_pic(flip_, v, dt, as[d], vn[d]);
-      w = flip_pic(flip_, w, dt, aw[d], wn[d]);
+      if (as) {
+        v = vn[d];
+        w = wn[d];
+        for (int j = 0; j < D; ++j) {
+          P.col(Bs_, d * D + j)[i] = Bs[d][j];
+          P.col(Bw_, d * D + j)[i] = Bw[d][j];
+        }
+      } else {
+        v = flip_pic(flip_, v, dt, acc_s[d], vn[d]);
+        w = flip_pic(flip_, w, dt, acc_w[d], wn[d]);
+      }
       if constexpr (MOVE)
         P.col(P.position, d)[i] = sim.held_faces.moved(d, P.col(P.position, d)[i], dt * vn[d]);
       else
@@ -525,12 +633,14 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     double* L = sc.L.data();
     double max_v2 = sc.max_v2;
     const auto F = deformation_gradient_block(P, F_, b);
+    AffineStencil as;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       // USL: the velocity update happens here; MUSL did it in the re-map pass.
       // (the stencil was evaluated at x^n above, so moving here does not change it).
       if constexpr (!REMAPPED)
-        max_v2 = std::max(max_v2, velocity_update<true>(sim, P, st, p, i, npp, dt));
+        max_v2 = std::max(max_v2, velocity_update<true>(sim, P, st, p, i, npp, dt, nullptr,
+                                                        apic_ ? &as : nullptr));
       double ls[D][D] = {}, lw[D][D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);

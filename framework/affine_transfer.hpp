@@ -1,0 +1,140 @@
+#pragma once
+// The affine particle-in-cell transfer (APIC, Jiang, Schroeder, Selle, Teran & Stomakhin 2015,
+// J. Comput. Phys. 280 / SIGGRAPH 2015), as a building block every scheme's P2G and G2P loops
+// call per particle and stencil entry, for each velocity field it transfers (the single-phase
+// velocity; the solid and water velocities of the two-phase schemes).
+//
+// Each particle carries, per field, the velocity's first moment about it, B_p (a D x D field).
+// G2P from the updated grid velocities v_I, at the particle's position before the move:
+//   v_p = sum_I N_Ip v_I,   B_p = sum_I N_Ip v_I (x_I - x_p)^T;
+// P2G (and a MUSL re-map), with the inertia D_p = sum_I N_Ip (x_I - x_p)(x_I - x_p)^T of the
+// particle's current position:
+//   (m v)_I = sum_p m_p N_Ip (v_p + B_p D_p^-1 (x_I - x_p)).
+// D_p comes from the weights: h^2/4 I for interior quadratic B-splines, GIMP's and CPDI's from
+// their domain-averaged weights (invertible: a domain spans nodes). Keeping B_p, not
+// C_p = B_p D_p^-1, and taking D_p where the particle is when it scatters is what conserves
+// angular momentum over the move for weights whose D_p changes with position. Linear and angular
+// momentum are conserved by the transfers; the affine part carries no PIC dissipation and no
+// FLIP noise (tests/test_apic.cpp).
+//
+// Multilinear tents (shape functions whose stencil does not cover the particle's domain) are the
+// exception: there N_Ip D_p^-1 (x_I - x_p) = grad N_Ip (Jiang et al. 2015, section 5.3) does not
+// vanish with N_Ip, so a node a particle has just reached carries the affine term on a vanishing
+// mass and an acceleration f_I / m_I that grows as 1 / N_Ip. Measured 2026-12-04 on a bar
+// translating across 0.1 m cells and a spinning disk (tests/test_apic.cpp): B_p D_p^-1 with D_p at
+// the new position, and C_p = sum_I v_I grad N_Ip^T from the updated grid, blew up at the bar's
+// free-end cell crossings (t = 0.25 s, 0.43 s); C_p = the velocity gradient of MUSL's plain
+// re-map damps the disk's rotation away at its free surface (0.2 % per step), and with an affine
+// re-map it blows up. What works: USF, where the particle carries C_p = the velocity gradient of
+// the P2G field (affine part included) at the particle, the gradient the stress update takes; its
+// light nodes hold their points' own affine velocities. So with linear tents the field holds C_p
+// (`gradient_form()`), the scheme stores it from its USF gradient pass, and schemes without USF
+// refuse the combination; angular momentum is then kept only approximately (the tests print it).
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+#include "force_inline.hpp"
+#include "particles.hpp"
+#include "shape_function.hpp"
+
+namespace loam {
+
+template <int D>
+class AffineTransfer {
+ public:
+  /// Entries of a stencil handled per particle (CPDI's widest, 4^D).
+  static constexpr int kMaxEntries = ipow(4, D);
+
+  /// x_I - x_p of every stencil entry of a particle, and D_p's accumulation.
+  struct Stencil {
+    double dx[kMaxEntries][D];
+    Eigen::Matrix<double, D, D> inertia;
+  };
+
+  /// Node coordinates (x_I - x_p without divisions) and the form: B_p, or C_p for shape
+  /// functions whose stencil does not cover the particle's domain (linear tents).
+  void setup(const Grid<D>& grid, const ShapeFunction<D>& shape) {
+    gradient_form_ = !shape.stencil_covers_domain();
+    node_x_.resize(grid.num_nodes * D);
+    for (size_t n = 0; n < grid.num_nodes; ++n)
+      for (int d = 0; d < D; ++d) node_x_[n * D + size_t(d)] = grid.node_coord(n, d);
+  }
+  /// Whether the particles carry C_p (linear tents, the header) rather than B_p.
+  bool gradient_form() const { return gradient_form_; }
+  /// The shape function's stencil fits (else: a located error by the scheme).
+  static bool fits(const ShapeFunction<D>& shape) {
+    return shape.max_nodes_per_particle() <= kMaxEntries;
+  }
+
+  /// x_I - x_p of every stencil entry of particle p (position xp), and D_p.
+  void stencil(const StencilBlock<D>& st, int p, int npp, const double* xp, Stencil& a) const {
+    a.inertia.setZero();
+    for (int k = 0; k < npp; ++k) {
+      const size_t kp = size_t(k) * kBlock + size_t(p);
+      const double* xI = node_x_.data() + size_t(st.node[kp]) * D;
+      for (int d = 0; d < D; ++d) a.dx[k][d] = xI[d] - xp[d];
+      if (gradient_form_) continue;  // C_p needs no inertia
+      for (int d = 0; d < D; ++d)
+        for (int j = 0; j < D; ++j) a.inertia(d, j) += st.w[kp] * a.dx[k][d] * a.dx[k][j];
+    }
+  }
+
+  /// mC = m_p B_p D_p^-1 (B row-major); m_p C_p in the gradient form.
+  void matrix(double mp, const double (&B)[D][D], const Stencil& a, double (&mC)[D][D]) const {
+    if (gradient_form_) {
+      for (int d = 0; d < D; ++d)
+        for (int j = 0; j < D; ++j) mC[d][j] = mp * B[d][j];
+      return;
+    }
+    Eigen::Matrix<double, D, D> Bm;
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) Bm(d, j) = mp * B[d][j];
+    const Eigen::Matrix<double, D, D> C = Bm * a.inertia.inverse();
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) mC[d][j] = C(d, j);
+  }
+
+  /// The momentum stencil entry k sends to its node: w (m v_p + (m B D^-1)(x_I - x_p)).
+  LOAM_FORCE_INLINE static void momentum(double w, const double* dx, const double (&mv)[D],
+                                         const double (&mC)[D][D], double (&out)[D]) {
+    for (int d = 0; d < D; ++d) {
+      double a = mv[d];
+      for (int j = 0; j < D; ++j) a += mC[d][j] * dx[j];
+      out[d] = w * a;
+    }
+  }
+
+  /// G2P of stencil entry k: B += w v_I (x_I - x_p)^T (nothing in the gradient form, whose C_p
+  /// the scheme's gradient pass stores).
+  LOAM_FORCE_INLINE void add_moment(double w, const double* vI, const double* dx,
+                                    double (&B)[D][D]) const {
+    if (gradient_form_) return;
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) B[d][j] += w * vI[d] * dx[j];
+  }
+
+  /// The particle field holding B_p (or C_p), requested only when APIC is on. `name` and
+  /// `what` (e.g. "affine_moment", "velocity") name the transferred field.
+  FieldInfo field_info(const std::string& name, const std::string& what) const {
+    std::vector<std::string> names;
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j) names.push_back(std::string(1, "xyz"[i]) + "xyz"[j]);
+    if (gradient_form_)
+      return {name, D * D, "1/s",
+              "APIC with linear tents (update: usf): C_p, the gradient of the P2G " + what +
+                  " field at the particle; the particle's field is v_p + C_p (x - x_p)",
+              names};
+    return {name, D * D, "m^2/s",
+            "APIC's B_p = sum_I N_Ip v_I (x_I - x_p)^T of the " + what +
+                " (Jiang et al. 2015): with the inertia D_p the particle's field is v_p + B_p "
+                "D_p^-1 (x - x_p)",
+            names};
+  }
+
+ private:
+  bool gradient_form_ = false;
+  std::vector<double> node_x_;  // num_nodes * D
+};
+
+}  // namespace loam
