@@ -83,14 +83,15 @@ std::string bench_scene(const std::string& scene, const std::string& shape,
                  "hydraulic_conductivity: 1.0e-4}}");
     return saturate_with_liquid_points(yaml);
   }
-  // The apic_ prefix: the single-phase block with APIC transfers (MUSL only).
+  // The apic_ prefix: the scene with APIC transfers (transfer: apic), single-phase or
+  // two_phase_, with the --update given (linear tents: usf only).
   const std::string apic = "apic_";
   if (scene.rfind(apic, 0) == 0) {
     std::string yaml = bench_scene(scene.substr(apic.size()), shape, update);
-    const std::string from = "scheme: {type: single_phase, update: " + update + "}";
+    const std::string from = "update: " + update + "}";
     const size_t k = yaml.find(from);
     if (yaml.empty() || k == std::string::npos) return "";
-    yaml.replace(k, from.size(), "scheme: {type: single_phase, update: musl, transfer: apic}");
+    yaml.replace(k, from.size(), "update: " + update + ", transfer: apic}");
     return yaml;
   }
   const bool two_phase = scene.rfind("two_phase_", 0) == 0;
