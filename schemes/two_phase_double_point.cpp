@@ -74,6 +74,7 @@
 #include <cmath>
 #include <memory>
 
+#include "framework/affine_transfer.hpp"
 #include "framework/cell_sums.hpp"
 #include "framework/drag.hpp"
 #include "framework/registry.hpp"
@@ -125,7 +126,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
              "surface full of liquid points: water that has spread out inside the soil (points "
              "s/n apart) fills its cells less and would lose its pressure there")
         .def("free");
-    add_flip_param(s);
+    add_transfer_params(s, "; gimp, bspline2 or cpdi");
     s.check([](const Params& p, Diagnostics& d) {
       if (p.has("max_porosity") && p.real("max_porosity") <= p.real("porosity"))
         d.error(p.where("max_porosity"), p.path("max_porosity"),
@@ -139,6 +140,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       : drag_(Registry::instance().create<Drag, D>(p.section("drag"))),
         n0_(p.real("porosity")),
         flip_(p.real("flip")),
+        apic_(p.text("transfer") == "apic"),
+        transfer_where_(p.where("transfer")),
+        transfer_path_(p.path("transfer")),
         smooth_(p.text("pressure_smoothing") == "cell"),
         n_max_(p.has("max_porosity") ? p.real("max_porosity") : 2.0),
         free_filling_(p.real("free_surface_filling")),
@@ -178,7 +182,22 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
     initialize_particles(sim, sim.sets[kSolid], 0, sim.sets[kSolid].size());
+    if (apic_) setup_apic(sim, diag);
     if (diag.ok()) fill_pores(sim);
+  }
+
+  /// transfer: apic: every point keeps B_p of its phase's velocity (solid points of v, liquid
+  /// points of w). Linear tents need USF's gradient (framework/affine_transfer.hpp); this scheme
+  /// is MUSL only: refused.
+  void setup_apic(Simulation<D>& sim, Diagnostics& diag) {
+    affine_.setup(sim.grid, *sim.shape);
+    B_ = sim.request_field(
+        affine_.field_info("affine_moment", "point's own phase velocity (solid v, liquid w)"));
+    if (affine_.gradient_form() || !AffineTransfer<D>::fits(*sim.shape))
+      diag.error(transfer_where_, transfer_path_,
+                 "transfer: apic in this scheme needs gimp, bspline2 or cpdi (linear tents take "
+                 "APIC with update: usf only, which this scheme does not offer: "
+                 "framework/affine_transfer.hpp)");
   }
 
   /// Solid points: porosity n0, solid mass (1 - n0) rho_s V, in contact. Liquid points (a
@@ -252,6 +271,12 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   static constexpr double kMinPorosity = 1e-3;
   std::unique_ptr<Drag<D>> drag_;
   double n0_, flip_;
+  bool apic_;
+  Location transfer_where_;  // for set-up errors about `transfer`
+  std::string transfer_path_;
+  int B_ = -1;                // APIC: each point's B_p of its own phase's velocity, or -1
+  AffineTransfer<D> affine_;  // APIC's per-entry algebra (framework/affine_transfer.hpp)
+  using AffineStencil = typename AffineTransfer<D>::Stencil;
   int n_ = -1, p_ = -1, F_ = -1;
   std::vector<double> node_;
   std::vector<double> vol_;          // per node: V_I = int N_I dOmega
@@ -434,6 +459,25 @@ class TwoPhaseDoublePoint : public Scheme<D> {
 
   // ------------------------------------------------------------------ particle to grid
   /// Solid points: mass, momentum, force (effective stress, weight, loads), drag, solid volume.
+  /// APIC: point i's stencil geometry at its position and m B_p D_p^-1 (mass m).
+  void affine_matrix(const Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
+                     double m, AffineStencil& as, double (&mC)[D][D]) const {
+    double xp[D], B[D][D];
+    for (int d = 0; d < D; ++d) {
+      xp[d] = P.col(P.position, d)[i];
+      for (int j = 0; j < D; ++j) B[d][j] = P.col(B_, d * D + j)[i];
+    }
+    affine_.stencil(st, p, npp, xp, as);
+    affine_.matrix(m, B, as, mC);
+  }
+  /// APIC: the momentum a stencil entry (weight w, x_I - x_p = dx) adds to its node's slot r.
+  static void add_affine_momentum(double w, const double* dx, const double (&mv)[D],
+                                  const double (&mC)[D][D], double* r) {
+    double a[D];
+    AffineTransfer<D>::momentum(w, dx, mv, mC, a);
+    for (int d = 0; d < D; ++d) r[d] += a[d];
+  }
+
   template <int NPP>
   void scatter_solid(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
     Particles<D>& P = set.particles;
@@ -446,15 +490,17 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     const double* n = P.col(n_) + b;
     drag_coefficients(P, st, b, count, npp, sc.Q.data());
     double* g = node_.data();
+    AffineStencil as;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      double mv[D], body[D], sv[D][D];
+      double mv[D], body[D], sv[D][D], mC[D][D] = {};
       for (int d = 0; d < D; ++d) {
         mv[d] = ms[p] * P.col(P.velocity, d)[i];
         const double fe = sim.external_force >= 0 ? P.col(sim.external_force, d)[i] : 0.0;
         body[d] = ms[p] * sim.gravity[size_t(d)] + fe;
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * P.col(P.stress, voigt_index(d, j))[i];
       }
+      if (apic_) affine_matrix(P, st, p, i, npp, ms[p], as, mC);
       const double vq = V[p] * sc.Q[size_t(p)], vs = (1 - n[p]) * V[p];
       cell_solid_[particle_cell(sim.grid, P, i)] += vs;  // in the stencil: race-free
       for (int k = 0; k < npp; ++k) {
@@ -464,8 +510,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         r[kMs] += w * ms[p];
         r[kQ] += w * vq;
         r[kN] += w * vs;
+        if (apic_) add_affine_momentum(w, as.dx[k], mv, mC, r + kV);
         for (int d = 0; d < D; ++d) {
-          r[kV + d] += w * mv[d];
+          if (!apic_) r[kV + d] += w * mv[d];
           double f = w * body[d];
           for (int j = 0; j < D; ++j)
             f -= sv[d][j] * st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
@@ -512,24 +559,27 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     const double* V = P.col(P.volume) + b;
     double* n = P.col(n_) + b;
     double* g = node_.data();
+    AffineStencil as;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       n[p] = liquid_porosity(liquid_cell_[i]);  // the solid set is scattered first
       const double Vmix = V[p] / n[p];
-      double mv[D], body[D], sv[D][D];
+      double mv[D], body[D], sv[D][D], mC[D][D] = {};
       for (int d = 0; d < D; ++d) {
         mv[d] = mw[p] * P.col(P.velocity, d)[i];
         const double fe = sim.external_force >= 0 ? P.col(sim.external_force, d)[i] : 0.0;
         body[d] = mw[p] * sim.gravity[size_t(d)] + fe;
         for (int j = 0; j < D; ++j) sv[d][j] = Vmix * P.col(P.stress, voigt_index(d, j))[i];
       }
+      if (apic_) affine_matrix(P, st, p, i, npp, mw[p], as, mC);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
         double* r = g + size_t(st.node[kp]) * S;
         r[kMw] += w * mw[p];
+        if (apic_) add_affine_momentum(w, as.dx[k], mv, mC, r + kW);
         for (int d = 0; d < D; ++d) {
-          r[kW + d] += w * mv[d];
+          if (!apic_) r[kW + d] += w * mv[d];
           r[kFw + d] += w * body[d];
           double f = 0;
           for (int j = 0; j < D; ++j)
@@ -649,8 +699,15 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     double* move = move_[phase].data() + b * D;
     const double flip = flip_;
     double max_v2 = sc.max_v2;
+    AffineStencil as;
     for (int p = 0; p < count; ++p) {
-      double vg[D] = {}, ag[D] = {};
+      const size_t i = b + size_t(p);
+      double vg[D] = {}, ag[D] = {}, B[D][D] = {};
+      if (apic_) {  // B_p = sum_I N_Ip v_I (x_I - x_p)^T at x^n (framework/affine_transfer.hpp)
+        double xp[D];
+        for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
+        affine_.stencil(st, p, npp, xp, as);
+      }
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
@@ -659,15 +716,29 @@ class TwoPhaseDoublePoint : public Scheme<D> {
           vg[d] += w * r[kv + d];
           ag[d] += w * r[ka + d];
         }
+        if (apic_) affine_.add_moment(w, r + kv, as.dx[k], B);
       }
       double v2 = 0, vp[D];
       for (int d = 0; d < D; ++d) {
-        double& v = P.col(P.velocity, d)[b + size_t(p)];
-        v = vp[d] = flip_pic(flip, v, dt, ag[d], vg[d]);
+        double& v = P.col(P.velocity, d)[i];
+        v = vp[d] = apic_ ? vg[d] : flip_pic(flip, v, dt, ag[d], vg[d]);
         move[size_t(p) * D + size_t(d)] = dt * vg[d];
         v2 += vp[d] * vp[d];
+        if (apic_)
+          for (int j = 0; j < D; ++j) P.col(B_, d * D + j)[i] = B[d][j];
       }
       max_v2 = std::max(max_v2, v2);
+      if (apic_) {  // the re-map carries the affine momentum too
+        double mv[D], mC[D][D];
+        for (int d = 0; d < D; ++d) mv[d] = m[p] * vp[d];
+        affine_.matrix(m[p], B, as, mC);
+        for (int k = 0; k < npp; ++k)
+          add_affine_momentum(st.w[size_t(k) * kBlock + size_t(p)], as.dx[k], mv, mC,
+                              remap_.data() +
+                                  size_t(st.node[size_t(k) * kBlock + size_t(p)]) * 2 * D +
+                                  size_t(phase * D));
+        continue;
+      }
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double wm = st.w[kp] * m[p];

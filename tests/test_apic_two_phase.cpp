@@ -1,9 +1,10 @@
-// APIC in the two-phase single-point scheme (issue 17, deliverable 1;
-// schemes/two_phase_single_point.cpp, framework/affine_transfer.hpp): each particle carries B_p
-// of the solid and of the water velocity. A saturated disk spinning freely keeps the mixture's
-// angular momentum (PIC loses it); the Terzaghi column (docs/verification.md C) gives the same
-// consolidation with APIC as with FLIP; a rigid translation gives no stress or pore pressure;
-// bad input gives located errors.
+// APIC in the two-phase schemes (issue 17, deliverable 1; framework/affine_transfer.hpp). The
+// single-point scheme (schemes/two_phase_single_point.cpp): each particle carries B_p of the
+// solid and of the water velocity; the double-point scheme (schemes/two_phase_double_point.cpp):
+// each solid or liquid point carries B_p of its own phase's velocity. A saturated disk spinning
+// freely keeps the mixture's angular momentum (PIC loses it); the Terzaghi column
+// (docs/verification.md C) gives the same consolidation with APIC as with FLIP; a rigid translation
+// gives no stress or pore pressure; bad input gives located errors.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
@@ -211,4 +212,127 @@ TEST_CASE("apic two-phase: bad transfer input gives located errors",
     CHECK(r.output.find(c.message) != std::string::npos);
     CHECK(!fs::exists(dir.path / "out"));
   }
+}
+
+namespace {
+
+/// A free saturated disk in the double-point scheme: solid points (elastic) and liquid points
+/// (water, K_w = 20 MPa) at the same places, radius 0.5 m about (1, 1), no gravity.
+std::string double_point_disk(const std::string& shape, const std::string& scheme) {
+  return "grid: {extent: [2, 2], cell_size: 0.1}\ngravity: [0, 0]\nshape_function: " + shape +
+         "\nscheme: {type: two_phase_double_point, porosity: 0.4, drag: {type: darcy, "
+         "hydraulic_conductivity: 1.0e-3}" +
+         scheme +
+         "}\nbodies:\n"
+         "  - {name: grains, set: solid, generator: {type: sphere, center: [1, 1], radius: 0.5}, "
+         "material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 2650}}\n"
+         "  - {name: water, set: liquid, generator: {type: sphere, center: [1, 1], radius: 0.5}, "
+         "material: {type: newtonian_fluid, bulk_modulus: 2.0e7, viscosity: 1.0e-3, density: "
+         "1000}}\n"
+         "time: {end: 100, cfl: 0.5}\n";
+}
+
+/// Angular momentum about the centre of every point of both sets, with its affine share; with
+/// `start`, each point's mass and position are those it had at the step's start (by set and id).
+double angular_momentum_dp(loam::Simulation<2>& sim,
+                           const std::map<std::pair<int, uint32_t>, Start>* start = nullptr) {
+  double L = 0;
+  for (int k = 0; k < 2; ++k) {
+    auto& P = sim.sets[size_t(k)].particles;
+    const int B = P.find("affine_moment");
+    for (size_t i = 0; i < P.size(); ++i) {
+      const Start s =
+          start ? start->at({k, P.id[i]})
+                : Start{P.col(P.mass)[i], P.col(P.position, 0)[i], P.col(P.position, 1)[i]};
+      const double x = s.x - kCentre, y = s.y - kCentre;
+      L += s.mw * (x * P.col(P.velocity, 1)[i] - y * P.col(P.velocity, 0)[i]);
+      if (B >= 0) L += s.mw * (P.col(B, 2)[i] - P.col(B, 1)[i]);
+    }
+  }
+  return L;
+}
+
+Spin spin_double_point(const std::string& shape, const std::string& scheme, int steps) {
+  auto sim = loam_test::make_simulation<2>(double_point_disk(shape, scheme));
+  for (auto& set : sim->sets) {
+    auto& P = set.particles;
+    for (size_t i = 0; i < P.size(); ++i) {
+      P.col(P.velocity, 0)[i] = -kOmega * (P.col(P.position, 1)[i] - kCentre);
+      P.col(P.velocity, 1)[i] = kOmega * (P.col(P.position, 0)[i] - kCentre);
+    }
+  }
+  loam_test::advance(*sim, 1);
+  const double L1 = angular_momentum_dp(*sim);
+  Spin r;
+  for (int s = 0; s < steps; ++s) {
+    std::map<std::pair<int, uint32_t>, Start> start;
+    for (int k = 0; k < 2; ++k) {
+      auto& P = sim->sets[size_t(k)].particles;
+      for (size_t i = 0; i < P.size(); ++i)
+        start[{k, P.id[i]}] = {P.col(P.mass)[i], P.col(P.position, 0)[i], P.col(P.position, 1)[i]};
+    }
+    const double before = angular_momentum_dp(*sim, &start);
+    loam_test::advance(*sim, 1);
+    r.per_step =
+        std::max(r.per_step, std::fabs(angular_momentum_dp(*sim, &start) - before) / std::fabs(L1));
+  }
+  r.drift = std::fabs(angular_momentum_dp(*sim) / L1 - 1);
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("apic double point: a spinning saturated disk keeps its angular momentum",
+          "[apic][transfer][double_point]") {
+  // Solid and liquid points each carry B_p of their phase's velocity; both transfers, the drag
+  // pair at each node and the symmetric stresses keep the total angular momentum. Checked per
+  // step at the masses and positions of the step's P2G (target 1e-12 of L, 300 steps), and over
+  // the run against FLIP and PIC (PIC: above 0.5).
+  for (const char* shape : {"gimp", "bspline2"}) {
+    const auto apic = spin_double_point(shape, ", transfer: apic", 300);
+    const auto flip = spin_double_point(shape, "", 300);
+    const auto pic = spin_double_point(shape, ", flip: 0", 300);
+    std::printf(
+        "double-point spinning disk, %s, 300 steps: APIC per-step change %.2e, drift %.2e; "
+        "FLIP per-step %.2e, drift %.2e; PIC drift %.2e\n",
+        shape, apic.per_step, apic.drift, flip.per_step, flip.drift, pic.drift);
+    CHECK(apic.per_step < 1e-12);
+    CHECK(pic.drift > 0.5);
+  }
+}
+
+TEST_CASE("apic double point: the Terzaghi column consolidates as with FLIP",
+          "[apic][transfer][double_point][verification]") {
+  // configs/terzaghi_double_point.yaml (docs/verification.md F, target 0.03 p0), FLIP against
+  // APIC with gimp: both within the target, and within 0.005 p0 of each other.
+  loam_test::TempDir f("terzaghi_dp_flip"), a("terzaghi_dp_apic");
+  const std::string base = "--threads 1 --set shape_function=gimp";
+  const auto sf = loam_test::run_scene("terzaghi_double_point.yaml", f.path, base);
+  const auto sa = loam_test::run_scene("terzaghi_double_point.yaml", a.path,
+                                       base + " --set scheme.transfer=apic");
+  const double ef = sf["verify"]["max_error"], ea = sa["verify"]["max_error"];
+  std::printf("double-point terzaghi column, gimp: max |p - p_ref| / p0 FLIP %.4f, APIC %.4f\n", ef,
+              ea);
+  CHECK(ef <= 0.03);
+  CHECK(ea <= 0.03);
+  CHECK(std::fabs(ea - ef) <= 0.005);
+}
+
+TEST_CASE("apic double point: linear tents are a located error",
+          "[apic][transfer][double_point][bad_config]") {
+  namespace fs = std::filesystem;
+  loam_test::TempDir dir("apic_double_point_bad");
+  fs::create_directories(dir.path);
+  const auto r = loam_test::run_yaml(
+      dir.path,
+      "grid: {extent: [1, 1], cell_size: 0.25}\nscheme: {type: two_phase_double_point, porosity: "
+      "0.4, drag: {type: darcy, hydraulic_conductivity: 1.0e-3}, transfer: apic}\nbodies:\n  - "
+      "{name: b, set: solid, generator: {type: box, min: [0, 0], max: [0.5, 0.5]}, material: "
+      "{type: linear_elastic, E: 1.0e6, nu: 0.3, density: 2650}}\ntime: {end: 0.1}\n");
+  INFO(r.output);
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("run.yaml:2:") != std::string::npos);
+  CHECK(r.output.find("scheme.transfer: transfer: apic in this scheme needs gimp") !=
+        std::string::npos);
+  CHECK(!fs::exists(dir.path / "out"));
 }
