@@ -79,6 +79,18 @@ TEST_CASE("a resumed single-phase run is bitwise the uninterrupted one, 1 and 2 
     check_resume("vibrating_bar.yaml", std::string("--threads ") + threads, 500, 7500);
 }
 
+TEST_CASE("a resumed APIC run (affine_moment) is bitwise the uninterrupted one, 1 and 2 threads",
+          "[checkpoint][apic]") {
+  // configs/granular_collapse_2d.yaml on 0.02 m cells with transfer: apic and gimp (about 9000
+  // steps to t = 1 s): the checkpoint of step 4000 carries every particle's B_p.
+  for (const char* threads : {"1", "2"})
+    check_resume("granular_collapse_2d.yaml",
+                 std::string("--threads ") + threads +
+                     " --set grid.cell_size=0.02 --set shape_function=gimp --set "
+                     "scheme.transfer=apic --set scheme.flip=1",
+                 2000, 4000);
+}
+
 TEST_CASE("a resumed two-phase run is bitwise the uninterrupted one, 1 and 2 threads",
           "[checkpoint]") {
   // configs/seed001_terzaghi.yaml (two_phase_single_point, terzaghi reference) to t = 0.1 s.
