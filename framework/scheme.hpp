@@ -49,7 +49,7 @@ class Scheme {
   }
   virtual void step(Simulation<D>&, double dt) = 0;
   /// Particle velocity fields besides `velocity` (e.g. the pore water's of a single-point
-  /// two-phase scheme): a stage's `reset: [velocity]` zeroes them too.
+  /// two-phase scheme, APIC's affine matrices): a stage's `reset: [velocity]` zeroes them too.
   virtual std::vector<std::string> velocity_fields() const { return {}; }
   /// Phases on the grid: 1, or 2 for a scheme with a pore-water phase (boundary phase 1).
   virtual int phases() const { return 1; }

@@ -62,6 +62,11 @@ class SinglePhase : public Scheme<D> {
         apic_(p.text("transfer") == "apic"),
         sets_(p.strings("sets")) {}
 
+  /// APIC's affine matrix is part of the particle velocity field (a velocity reset zeroes it).
+  std::vector<std::string> velocity_fields() const override {
+    return apic_ ? std::vector<std::string>{"affine_moment"} : std::vector<std::string>{};
+  }
+
   std::vector<SetDeclaration> particle_sets() const override {
     std::vector<SetDeclaration> s;
     for (const auto& n : sets_) s.push_back({n, "material points on the one velocity field"});

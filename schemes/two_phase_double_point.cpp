@@ -149,6 +149,10 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         zero_surface_pressure_(p.text("free_surface_pressure") == "zero") {}
 
   int phases() const override { return 2; }
+  /// APIC's affine matrix is part of each point's velocity field (a velocity reset zeroes it).
+  std::vector<std::string> velocity_fields() const override {
+    return apic_ ? std::vector<std::string>{"affine_moment"} : std::vector<std::string>{};
+  }
   std::vector<SetDeclaration> particle_sets() const override {
     return {{"solid", "soil grains: the skeleton, effective stress, solid mass (1 - n) rho_s V"},
             {"liquid", "water: a fluid material, intrinsic water volume and density"}};

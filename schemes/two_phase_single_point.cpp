@@ -112,7 +112,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         smooth_(p.text("pressure_smoothing") == "cell") {}
 
   int phases() const override { return 2; }
-  std::vector<std::string> velocity_fields() const override { return {"water_velocity"}; }
+  std::vector<std::string> velocity_fields() const override {
+    if (apic_) return {"water_velocity", "affine_moment", "water_affine_moment"};
+    return {"water_velocity"};
+  }
   std::vector<SetDeclaration> particle_sets() const override {
     return {{"particles", "points of the saturated mixture: the skeleton carrying its pore water"}};
   }

@@ -122,7 +122,7 @@ TEST_CASE("apic with update usl and usf: the spinning disk keeps its angular mom
 
 TEST_CASE("apic with linear tents (usf): the spinning disk keeps spinning", "[apic][transfer]") {
   // Linear tents carry C_p, the velocity gradient of USF's P2G field at the particle
-  // (schemes/single_phase.cpp says why, and why not with musl or usl): the angular momentum is
+  // (framework/affine_transfer.hpp says why, and why not with musl or usl): the angular momentum is
   // kept only approximately. Measured and printed; asserted: the disk keeps spinning (kinetic
   // energy and angular momentum within 5 % after 2000 steps), where PIC loses them.
   const auto apic = spin("linear", "transfer: apic, update: usf", 2000);
@@ -218,7 +218,7 @@ TEST_CASE("apic: a rigid translation across cells gives no stress, for every sha
   // A free bar (1D) and a free block (2D) translating at 1 m/s across 10 cells: the velocity
   // field is uniform, so B_p (C_p with linear tents) stays zero, the velocity stays 1 m/s and no
   // stress appears, also as the free ends enter new cells (with linear tents B_p D_p^-1 at a new
-  // position once blew this up: schemes/single_phase.cpp; they run with update: usf).
+  // position once blew this up: framework/affine_transfer.hpp; they run with update: usf).
   // Targets: |v - 1| < 1e-12 m/s,
   // |sigma| < 1e-6 Pa (E = 1 MPa).
   for (const char* shape : {"linear", "gimp", "bspline2", "cpdi"}) {
@@ -260,5 +260,75 @@ TEST_CASE("apic: a rigid translation across cells gives no stress, for every sha
       CHECK(max_dv < 1e-12);
       CHECK(max_sig < 1e-6);
     }
+  }
+}
+
+TEST_CASE("apic: a stage's velocity reset zeroes the affine matrices, in every scheme",
+          "[apic][transfer][stages]") {
+  // A stage's reset: [velocity] must leave no motion behind: the affine matrices are part of
+  // the particle velocity field (Scheme::velocity_fields), else the first P2G after the reset
+  // sends m_p N B_p D_p^-1 (x_I - x_p) to the nodes. A disk spins for 50 steps (B_p nonzero),
+  // then the second stage begins: every velocity and affine component must be exactly 0.
+  const std::string tail =
+      "stages:\n  - {name: spin, until: static, max_time: 1}\n"
+      "  - {name: still, until: static, max_time: 1, reset: [velocity]}\n";
+  const std::string sp = disk("gimp", "transfer: apic") + tail;
+  const std::string water =
+      "material: {type: newtonian_fluid, bulk_modulus: 2.0e7, viscosity: 1.0e-3, density: 1000}";
+  const char* names[] = {"single_phase", "two_phase_single_point", "two_phase_double_point"};
+  int scheme = 0;
+  for (const std::string& yaml :
+       {sp,
+        "grid: {extent: [2, 2], cell_size: 0.1}\ngravity: [0, 0]\nshape_function: gimp\n"
+        "scheme: {type: two_phase_single_point, porosity: 0.4, transfer: apic, drag: {type: "
+        "darcy, hydraulic_conductivity: 1.0e-3}}\nbodies:\n  - {name: d, generator: {type: "
+        "sphere, center: [1, 1], radius: 0.5}, material: {type: linear_elastic, E: 1.0e6, nu: "
+        "0.3, density: 2650}}\ntime: {end: 100, cfl: 0.5}\n" +
+            tail,
+        "grid: {extent: [2, 2], cell_size: 0.1}\ngravity: [0, 0]\nshape_function: gimp\n"
+        "scheme: {type: two_phase_double_point, porosity: 0.4, transfer: apic, drag: {type: "
+        "darcy, hydraulic_conductivity: 1.0e-3}}\nbodies:\n  - {name: g, set: solid, "
+        "generator: {type: sphere, center: [1, 1], radius: 0.5}, material: {type: "
+        "linear_elastic, E: 1.0e6, nu: 0.3, density: 2650}}\n  - {name: w, set: liquid, "
+        "generator: {type: sphere, center: [1, 1], radius: 0.5}, " +
+            water + "}\ntime: {end: 100, cfl: 0.5}\n" + tail}) {
+    std::string staged = yaml;  // a run with stages takes its time from them
+    const std::string end = "time: {end: 100, cfl: 0.5}";
+    staged.replace(staged.find(end), end.size(), "time: {cfl: 0.5}");
+    auto sim = loam_test::make_simulation<2>(staged);
+    for (auto& set : sim->sets) {
+      auto& P = set.particles;
+      const int w = P.find("water_velocity");
+      for (size_t i = 0; i < P.size(); ++i) {
+        const double vx = -kOmega * (P.col(P.position, 1)[i] - kCentre),
+                     vy = kOmega * (P.col(P.position, 0)[i] - kCentre);
+        P.col(P.velocity, 0)[i] = vx;
+        P.col(P.velocity, 1)[i] = vy;
+        if (w >= 0) P.col(w, 0)[i] = vx, P.col(w, 1)[i] = vy;
+      }
+    }
+    loam_test::advance(*sim, 50);
+    double before = 0, after = 0;
+    auto largest = [&] {
+      double m = 0;
+      for (auto& set : sim->sets) {
+        auto& P = set.particles;
+        for (const char* f :
+             {"velocity", "water_velocity", "affine_moment", "water_affine_moment"}) {
+          const int h = P.find(f);
+          if (h < 0) continue;
+          for (int c = 0; c < P.info(h).components; ++c)
+            for (size_t i = 0; i < P.size(); ++i) m = std::max(m, std::fabs(P.col(h, c)[i]));
+        }
+      }
+      return m;
+    };
+    before = largest();
+    sim->begin_stage(1);
+    after = largest();
+    std::printf("%s: largest velocity or affine component %.3g before the reset, %.3g after\n",
+                names[scheme++], before, after);
+    CHECK(before > 0.01);
+    CHECK(after == 0.0);
   }
 }
