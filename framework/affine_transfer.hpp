@@ -80,6 +80,32 @@ class AffineTransfer {
     }
   }
 
+  /// The stencil geometry of particle p of the block (index i in P) at its current position.
+  void stencil(const Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
+               Stencil& a) const {
+    double xp[D];
+    for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
+    stencil(st, p, npp, xp, a);
+  }
+
+  /// Particle i's B_p (or C_p) from its field `field` (D x D, row-major), and back.
+  static void load(const Particles<D>& P, int field, size_t i, double (&B)[D][D]) {
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) B[d][j] = P.col(field, d * D + j)[i];
+  }
+  static void store(Particles<D>& P, int field, size_t i, const double (&B)[D][D]) {
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) P.col(field, d * D + j)[i] = B[d][j];
+  }
+
+  /// mC = m B D^-1 of particle i from its field `field`, at the stencil geometry `a`.
+  void matrix(const Particles<D>& P, int field, size_t i, double m, const Stencil& a,
+              double (&mC)[D][D]) const {
+    double B[D][D];
+    load(P, field, i, B);
+    matrix(m, B, a, mC);
+  }
+
   /// mC = m_p B_p D_p^-1 (B row-major); m_p C_p in the gradient form.
   void matrix(double mp, const double (&B)[D][D], const Stencil& a, double (&mC)[D][D]) const {
     if (gradient_form_) {
@@ -103,6 +129,14 @@ class AffineTransfer {
       for (int j = 0; j < D; ++j) a += mC[d][j] * dx[j];
       out[d] = w * a;
     }
+  }
+
+  /// The same momentum added to a node's slot r (D values).
+  LOAM_FORCE_INLINE static void add_momentum(double w, const double* dx, const double (&mv)[D],
+                                             const double (&mC)[D][D], double* r) {
+    double a[D];
+    momentum(w, dx, mv, mC, a);
+    for (int d = 0; d < D; ++d) r[d] += a[d];
   }
 
   /// G2P of stencil entry k: B += w v_I (x_I - x_p)^T (nothing in the gradient form, whose C_p

@@ -144,17 +144,13 @@ class SinglePhase : public Scheme<D> {
       // MUSL: re-map the updated particle momentum; the velocity gradient uses that field, and
       // particles move with the grid velocity of the update (Sulsky 1995).
       sim.timed("grid", [&] { zero_nodes(vel_, sim.threads); });
-      if (apic_)
-        sim.timed("g2p_velocity_remap", [&] { update_velocities_apic<NPP, true, false>(sim, dt); });
-      else
-        sim.timed("g2p_velocity_remap", [&] { update_velocities<NPP, true, false>(sim, dt); });
+      sim.timed("g2p_velocity_remap", [&] { update_velocities<NPP, true, false>(sim, dt); });
       sim.timed("grid", [&] { momentum_to_velocity(sim, vel_.data(), D, 0); });
       sim.timed("g2p_gradient_stress", [&] { update_stresses<NPP, Gradient::kRemapped>(sim, dt); });
     } else {
       // USL: gradient, move and velocity update from the updated grid record in one pass (APIC:
       // its G2P first, at the positions before the move; the pass then only moves).
-      if (apic_)
-        sim.timed("g2p_velocity", [&] { update_velocities_apic<NPP, false, false>(sim, dt); });
+      if (apic_) sim.timed("g2p_velocity", [&] { update_velocities<NPP, false, false>(sim, dt); });
       sim.timed("g2p_gradient_stress", [&] { update_stresses<NPP, Gradient::kUpdated>(sim, dt); });
     }
     sim.max_speed = max_speed(scratch_);
@@ -170,10 +166,7 @@ class SinglePhase : public Scheme<D> {
     scatter_all<NPP, false, true>(sim);
     update_nodes(sim, dt);
     reset_max_speed(scratch_);
-    if (apic_)
-      update_velocities_apic<NPP, false, true>(sim, dt);
-    else
-      update_velocities<NPP, false, true>(sim, dt);
+    update_velocities<NPP, false, true>(sim, dt);
     sim.max_speed = max_speed(scratch_);
   }
 
@@ -186,23 +179,16 @@ class SinglePhase : public Scheme<D> {
       scatter<NPP, MOMENTUM, FORCE>(sim, s, b, c, t);
     });
   }
-  /// G2P velocity update (FLIP/PIC); with REMAP the new momentum is scattered into vel_ (MUSL),
-  /// with MOVE the particles move with the updated grid velocity.
+  /// G2P velocity update (FLIP/PIC, or APIC's: update_velocity_apic); with REMAP the new
+  /// momentum is scattered into vel_ (MUSL), with MOVE the particles move with the updated grid
+  /// velocity.
   template <int NPP, bool REMAP, bool MOVE>
   void update_velocities(Simulation<D>& sim, double dt) {
     auto f = [&](ParticleSet<D>& s, size_t b, int c, int t) {
-      update_velocity<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
-    };
-    if constexpr (REMAP)
-      sim.scatter_blocks(f);
-    else
-      sim.gather_blocks(f);
-  }
-  /// APIC's G2P (update_velocity_apic), REMAP and MOVE as in update_velocities.
-  template <int NPP, bool REMAP, bool MOVE>
-  void update_velocities_apic(Simulation<D>& sim, double dt) {
-    auto f = [&](ParticleSet<D>& s, size_t b, int c, int t) {
-      update_velocity_apic<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
+      if (apic_)
+        update_velocity_apic<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
+      else
+        update_velocity<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
     };
     if constexpr (REMAP)
       sim.scatter_blocks(f);
@@ -247,20 +233,15 @@ class SinglePhase : public Scheme<D> {
     for (int p = 0; p < count; ++p) {
       // Particle values in locals: the node stores below could alias the particle columns.
       const double mp = m[p];
-      double mv[D], body[D], sv[D][D], mC[D][D] = {}, xp[D] = {};  // mC: m_p B_p D_p^-1
+      double mv[D], body[D], sv[D][D], mC[D][D] = {};  // mC: m_p B_p D_p^-1
       for (int d = 0; d < D; ++d) {
         mv[d] = mp * v[size_t(d)][p];
         body[d] = mp * gravity[size_t(d)] + (fe[size_t(d)] ? fe[size_t(d)][p] : 0.0);
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * sig[size_t(voigt_index(d, j))][p];
       }
       if (affine) {
-        double B[D][D];
-        for (int d = 0; d < D; ++d) {
-          xp[d] = P.col(P.position, d)[b + size_t(p)];
-          for (int j = 0; j < D; ++j) B[d][j] = P.col(B_, d * D + j)[b + size_t(p)];
-        }
-        affine_.stencil(st, p, npp, xp, as);
-        affine_.matrix(mp, B, as, mC);
+        affine_.stencil(P, st, p, b + size_t(p), npp, as);
+        affine_.matrix(P, B_, b + size_t(p), mp, as, mC);
       }
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -269,9 +250,7 @@ class SinglePhase : public Scheme<D> {
         if constexpr (MOMENTUM) {
           r[kMass] += w * mp;
           if (affine) {  // APIC: m_p (N v_p + B_p D_p^-1 N (x_I - x_p)), see the header
-            double a[D];
-            affine_.momentum(w, as.dx[k], mv, mC, a);
-            for (int d = 0; d < D; ++d) r[kMomentum + d] += a[d];
+            affine_.add_momentum(w, as.dx[k], mv, mC, r + kMomentum);
           } else {
             for (int d = 0; d < D; ++d) r[kMomentum + d] += w * mv[d];
           }
@@ -414,9 +393,8 @@ class SinglePhase : public Scheme<D> {
     typename AffineTransfer<D>::Stencil as;
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      double xp[D], vp[D] = {}, B[D][D] = {};
-      for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
-      affine_.stencil(st, p, npp, xp, as);
+      double vp[D] = {}, B[D][D] = {};
+      affine_.stencil(P, st, p, i, npp, as);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
@@ -426,23 +404,20 @@ class SinglePhase : public Scheme<D> {
       }
       double v2 = 0, mv[D], mC[D][D];
       const double mp = P.col(P.mass)[i];
+      if (!affine_.gradient_form()) affine_.store(P, B_, i, B);  // linear: the USF gradient pass
       for (int d = 0; d < D; ++d) {
         P.col(P.velocity, d)[i] = vp[d];
         mv[d] = mp * vp[d];
         v2 += vp[d] * vp[d];
-        if (!affine_.gradient_form())  // linear tents: the USF gradient pass stores C_p
-          for (int j = 0; j < D; ++j) P.col(B_, d * D + j)[i] = B[d][j];
-        if constexpr (MOVE) P.col(P.position, d)[i] = walls.moved(d, xp[d], dt * vp[d]);
+        if constexpr (MOVE)
+          P.col(P.position, d)[i] = walls.moved(d, P.col(P.position, d)[i], dt * vp[d]);
       }
       max_v2 = std::max(max_v2, v2);
       if constexpr (!REMAP) continue;
       affine_.matrix(mp, B, as, mC);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
-        double a[D];
-        affine_.momentum(st.w[kp], as.dx[k], mv, mC, a);
-        double* r = remap + size_t(st.node[kp]) * D;
-        for (int d = 0; d < D; ++d) r[d] += a[d];
+        affine_.add_momentum(st.w[kp], as.dx[k], mv, mC, remap + size_t(st.node[kp]) * D);
       }
     }
     sc.max_v2 = max_v2;
@@ -491,8 +466,7 @@ class SinglePhase : public Scheme<D> {
       }
       store_velocity_gradient<D>(l, L, p);
       if (MODE == Gradient::kCurrent && B_ >= 0 && affine_.gradient_form())  // linear: C_p
-        for (int d = 0; d < D; ++d)
-          for (int j = 0; j < D; ++j) P.col(B_, d * D + j)[b + size_t(p)] = l[d][j];
+        affine_.store(P, B_, b + size_t(p), l);
       update_volume_and_deformation<D>(l, dt, V[p], F, p);
       if constexpr (kMove)
         for (int d = 0; d < D; ++d) x[size_t(d)][p] = walls.moved(d, x[size_t(d)][p], dt * vn[d]);

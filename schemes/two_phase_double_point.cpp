@@ -466,20 +466,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   /// APIC: point i's stencil geometry at its position and m B_p D_p^-1 (mass m).
   void affine_matrix(const Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
                      double m, AffineStencil& as, double (&mC)[D][D]) const {
-    double xp[D], B[D][D];
-    for (int d = 0; d < D; ++d) {
-      xp[d] = P.col(P.position, d)[i];
-      for (int j = 0; j < D; ++j) B[d][j] = P.col(B_, d * D + j)[i];
-    }
-    affine_.stencil(st, p, npp, xp, as);
-    affine_.matrix(m, B, as, mC);
-  }
-  /// APIC: the momentum a stencil entry (weight w, x_I - x_p = dx) adds to its node's slot r.
-  static void add_affine_momentum(double w, const double* dx, const double (&mv)[D],
-                                  const double (&mC)[D][D], double* r) {
-    double a[D];
-    AffineTransfer<D>::momentum(w, dx, mv, mC, a);
-    for (int d = 0; d < D; ++d) r[d] += a[d];
+    affine_.stencil(P, st, p, i, npp, as);
+    affine_.matrix(P, B_, i, m, as, mC);
   }
 
   template <int NPP>
@@ -514,7 +502,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         r[kMs] += w * ms[p];
         r[kQ] += w * vq;
         r[kN] += w * vs;
-        if (apic_) add_affine_momentum(w, as.dx[k], mv, mC, r + kV);
+        if (apic_) AffineTransfer<D>::add_momentum(w, as.dx[k], mv, mC, r + kV);
         for (int d = 0; d < D; ++d) {
           if (!apic_) r[kV + d] += w * mv[d];
           double f = w * body[d];
@@ -581,7 +569,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         const double w = st.w[kp];
         double* r = g + size_t(st.node[kp]) * S;
         r[kMw] += w * mw[p];
-        if (apic_) add_affine_momentum(w, as.dx[k], mv, mC, r + kW);
+        if (apic_) AffineTransfer<D>::add_momentum(w, as.dx[k], mv, mC, r + kW);
         for (int d = 0; d < D; ++d) {
           if (!apic_) r[kW + d] += w * mv[d];
           r[kFw + d] += w * body[d];
@@ -707,11 +695,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       double vg[D] = {}, ag[D] = {}, B[D][D] = {};
-      if (apic_) {  // B_p = sum_I N_Ip v_I (x_I - x_p)^T at x^n (framework/affine_transfer.hpp)
-        double xp[D];
-        for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
-        affine_.stencil(st, p, npp, xp, as);
-      }
+      // B_p = sum_I N_Ip v_I (x_I - x_p)^T at x^n (framework/affine_transfer.hpp)
+      if (apic_) affine_.stencil(P, st, p, i, npp, as);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
@@ -728,19 +713,19 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         v = vp[d] = apic_ ? vg[d] : flip_pic(flip, v, dt, ag[d], vg[d]);
         move[size_t(p) * D + size_t(d)] = dt * vg[d];
         v2 += vp[d] * vp[d];
-        if (apic_)
-          for (int j = 0; j < D; ++j) P.col(B_, d * D + j)[i] = B[d][j];
       }
       max_v2 = std::max(max_v2, v2);
       if (apic_) {  // the re-map carries the affine momentum too
+        affine_.store(P, B_, i, B);
         double mv[D], mC[D][D];
         for (int d = 0; d < D; ++d) mv[d] = m[p] * vp[d];
         affine_.matrix(m[p], B, as, mC);
-        for (int k = 0; k < npp; ++k)
-          add_affine_momentum(st.w[size_t(k) * kBlock + size_t(p)], as.dx[k], mv, mC,
-                              remap_.data() +
-                                  size_t(st.node[size_t(k) * kBlock + size_t(p)]) * 2 * D +
-                                  size_t(phase * D));
+        for (int k = 0; k < npp; ++k) {
+          const size_t kp = size_t(k) * kBlock + size_t(p);
+          AffineTransfer<D>::add_momentum(
+              st.w[kp], as.dx[k], mv, mC,
+              remap_.data() + size_t(st.node[kp]) * 2 * D + size_t(phase * D));
+        }
         continue;
       }
       for (int k = 0; k < npp; ++k) {

@@ -316,21 +316,17 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     }
   }
 
-  /// APIC: particle i's stencil geometry and m B D^-1 of both phases (solid mass ms, water mw).
-  void affine_matrices(Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
-                       double ms, double mw, AffineStencil& as, double (&mCs)[D][D],
-                       double (&mCw)[D][D]) const {
-    double xp[D], Bs[D][D], Bw[D][D];
+  /// APIC: m B D^-1 of both phases of particle i (solid mass ms, water mw) and their momenta
+  /// m v, at the stencil geometry `as`.
+  void affine_momenta(const Particles<D>& P, size_t i, double ms, double mw,
+                      const AffineStencil& as, double (&msv)[D], double (&mwv)[D],
+                      double (&mCs)[D][D], double (&mCw)[D][D]) const {
     for (int d = 0; d < D; ++d) {
-      xp[d] = P.col(P.position, d)[i];
-      for (int j = 0; j < D; ++j) {
-        Bs[d][j] = P.col(Bs_, d * D + j)[i];
-        Bw[d][j] = P.col(Bw_, d * D + j)[i];
-      }
+      msv[d] = ms * P.col(P.velocity, d)[i];
+      mwv[d] = mw * P.col(w_, d)[i];
     }
-    affine_.stencil(st, p, npp, xp, as);
-    affine_.matrix(ms, Bs, as, mCs);
-    affine_.matrix(mw, Bw, as, mCw);
+    affine_.matrix(P, Bs_, i, ms, as, mCs);
+    affine_.matrix(P, Bw_, i, mw, as, mCw);
   }
 
   template <int NPP>
@@ -361,8 +357,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       const double mw = n[p] * rho_w_ * V[p];
-      double vs[D], vw[D], body[D], sv[D][D], mCs[D][D] = {}, mCw[D][D] = {};
-      if (apic_) affine_matrices(P, st, p, i, npp, ms[p], mw, as, mCs, mCw);
+      double vs[D], vw[D], body[D], sv[D][D], msv[D] = {}, mwv[D] = {}, mCs[D][D] = {},
+                                              mCw[D][D] = {};
+      if (apic_) {
+        affine_.stencil(P, st, p, i, npp, as);
+        affine_momenta(P, i, ms[p], mw, as, msv, mwv, mCs, mCw);
+      }
       for (int d = 0; d < D; ++d) {
         vs[d] = P.col(P.velocity, d)[i];
         vw[d] = P.col(w_, d)[i];
@@ -383,24 +383,15 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         double gr[D];
         for (int j = 0; j < D; ++j)
           gr[j] = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
-        double ps[D], pw_[D];  // the phases' momenta this entry sends (APIC: affine)
-        if (apic_) {
-          double msv[D], mwv[D];
-          for (int d = 0; d < D; ++d) {
-            msv[d] = ms[p] * vs[d];
-            mwv[d] = mw * vw[d];
-          }
-          AffineTransfer<D>::momentum(w, as.dx[k], msv, mCs, ps);
-          AffineTransfer<D>::momentum(w, as.dx[k], mwv, mCw, pw_);
-        } else {
-          for (int d = 0; d < D; ++d) {
-            ps[d] = w * ms[p] * vs[d];
-            pw_[d] = w * mw * vw[d];
-          }
+        if (apic_) {  // the phases' affine momenta
+          AffineTransfer<D>::add_momentum(w, as.dx[k], msv, mCs, r + kV);
+          AffineTransfer<D>::add_momentum(w, as.dx[k], mwv, mCw, r + kW);
         }
         for (int d = 0; d < D; ++d) {
-          r[kV + d] += ps[d];
-          r[kW + d] += pw_[d];
+          if (!apic_) {
+            r[kV + d] += w * ms[p] * vs[d];
+            r[kW + d] += w * mw * vw[d];
+          }
           double f = w * body[d];
           for (int j = 0; j < D; ++j) f -= sv[d][j] * gr[j];
           r[kF + d] += f;
@@ -519,30 +510,14 @@ class TwoPhaseSinglePoint : public Scheme<D> {
                                                        apic_ ? &as : nullptr));
       const double ms = P.col(P.mass)[i], mw = P.col(n_)[i] * rho_w_ * P.col(P.volume)[i];
       double msv[D] = {}, mwv[D] = {}, mCs[D][D] = {}, mCw[D][D] = {};
-      if (apic_) {  // the re-map carries the affine momenta, with D_p at x^n (as the scatter)
-        double Bs[D][D], Bw[D][D];
-        for (int d = 0; d < D; ++d) {
-          msv[d] = ms * P.col(P.velocity, d)[i];
-          mwv[d] = mw * P.col(w_, d)[i];
-          for (int j = 0; j < D; ++j) {
-            Bs[d][j] = P.col(Bs_, d * D + j)[i];
-            Bw[d][j] = P.col(Bw_, d * D + j)[i];
-          }
-        }
-        affine_.matrix(ms, Bs, as, mCs);
-        affine_.matrix(mw, Bw, as, mCw);
-      }
+      // The re-map carries the affine momenta, with D_p at x^n (as the scatter).
+      if (apic_) affine_momenta(P, i, ms, mw, as, msv, mwv, mCs, mCw);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         double* r = remap_.data() + size_t(st.node[kp]) * 2 * D;
         if (apic_) {
-          double ps[D], pw[D];
-          AffineTransfer<D>::momentum(st.w[kp], as.dx[k], msv, mCs, ps);
-          AffineTransfer<D>::momentum(st.w[kp], as.dx[k], mwv, mCw, pw);
-          for (int d = 0; d < D; ++d) {
-            r[d] += ps[d];
-            r[D + d] += pw[d];
-          }
+          AffineTransfer<D>::add_momentum(st.w[kp], as.dx[k], msv, mCs, r);
+          AffineTransfer<D>::add_momentum(st.w[kp], as.dx[k], mwv, mCw, r + D);
         } else {
           for (int d = 0; d < D; ++d) {
             r[d] += st.w[kp] * ms * P.col(P.velocity, d)[i];
@@ -581,11 +556,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
                          int p, size_t i, int npp, double dt, double* move = nullptr,
                          AffineStencil* as = nullptr) {
     double vn[D] = {}, wn[D] = {}, acc_s[D] = {}, acc_w[D] = {}, Bs[D][D] = {}, Bw[D][D] = {};
-    if (as) {
-      double xp[D];
-      for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
-      affine_.stencil(st, p, npp, xp, *as);
-    }
+    if (as) affine_.stencil(P, st, p, i, npp, *as);
     for (int k = 0; k < npp; ++k) {
       const size_t kp = size_t(k) * kBlock + size_t(p);
       const double w = st.w[kp];
@@ -601,6 +572,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         affine_.add_moment(w, r + kW, as->dx[k], Bw);
       }
     }
+    if (as) {
+      affine_.store(P, Bs_, i, Bs);
+      affine_.store(P, Bw_, i, Bw);
+    }
     double v2 = 0;
     for (int d = 0; d < D; ++d) {
       double& v = P.col(P.velocity, d)[i];
@@ -608,10 +583,6 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       if (as) {
         v = vn[d];
         w = wn[d];
-        for (int j = 0; j < D; ++j) {
-          P.col(Bs_, d * D + j)[i] = Bs[d][j];
-          P.col(Bw_, d * D + j)[i] = Bw[d][j];
-        }
       } else {
         v = flip_pic(flip_, v, dt, acc_s[d], vn[d]);
         w = flip_pic(flip_, w, dt, acc_w[d], wn[d]);
