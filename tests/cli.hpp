@@ -102,6 +102,19 @@ inline CliResult run_yaml(const std::filesystem::path& dir, const std::string& y
                   (dir / "out").string() + " " + args);
 }
 
+/// `yaml` run as dir/run.yaml must be refused: exit code 2, an error at `location` (e.g.
+/// "run.yaml:2:") carrying `message`, and no output directory.
+inline void check_located_error(const std::filesystem::path& dir, const std::string& yaml,
+                                const std::string& location, const std::string& message) {
+  std::filesystem::remove_all(dir / "out");
+  const CliResult r = run_yaml(dir, yaml);
+  INFO(r.output);
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find(location) != std::string::npos);
+  CHECK(r.output.find(message) != std::string::npos);
+  CHECK(!std::filesystem::exists(dir / "out"));
+}
+
 /// Run a bash script through a real shell (for what a function call cannot show: signals to a
 /// running process, ulimit) and return the exit code of its last command, `$?`, which it
 /// writes to a file (std::system reports the shell's own status). No single quote in it.

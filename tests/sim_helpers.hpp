@@ -32,6 +32,22 @@ void advance(loam::Simulation<D>& sim, int steps) {
     if (!sim.advance(sim.stable_dt())) throw std::runtime_error(sim.failure);
 }
 
+/// Every particle of every set (velocity, and water_velocity where the scheme has it) in the
+/// rigid rotation v = omega x (x - c) about (cx, cy) in 2D.
+inline void set_rigid_rotation(loam::Simulation<2>& sim, double omega, double cx, double cy) {
+  for (auto& set : sim.sets) {
+    auto& P = set.particles;
+    const int w = P.find("water_velocity");
+    for (size_t i = 0; i < P.size(); ++i) {
+      const double vx = -omega * (P.col(P.position, 1)[i] - cy),
+                   vy = omega * (P.col(P.position, 0)[i] - cx);
+      P.col(P.velocity, 0)[i] = vx;
+      P.col(P.velocity, 1)[i] = vy;
+      if (w >= 0) P.col(w, 0)[i] = vx, P.col(w, 1)[i] = vy;
+    }
+  }
+}
+
 /// A reference plugin from its `verify:` YAML text, set up on `sim` (REQUIREs no errors).
 template <int D>
 std::unique_ptr<loam::Reference<D>> make_reference(loam::Simulation<D>& sim,

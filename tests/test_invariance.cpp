@@ -220,13 +220,7 @@ TEST_CASE("rigid spin: no strain rate in the interior, every scheme and shape fu
           "time: {end: 1}\n";
       auto sim = loam_test::make_simulation<2>(cfg);
       auto& P = sim->sets[0].particles;
-      const int w = P.find("water_velocity");
-      for (size_t i = 0; i < P.size(); ++i) {
-        const double x = P.col(P.position, 0)[i] - 1.0, y = P.col(P.position, 1)[i] - 1.0;
-        P.col(P.velocity, 0)[i] = -omega * y;
-        P.col(P.velocity, 1)[i] = omega * x;
-        if (w >= 0) P.col(w, 0)[i] = -omega * y, P.col(w, 1)[i] = omega * x;
-      }
+      loam_test::set_rigid_rotation(*sim, omega, 1.0, 1.0);
       std::vector<double> x0(P.size()), y0(P.size());
       for (size_t i = 0; i < P.size(); ++i)
         x0[P.id[i]] = P.col(P.position, 0)[i], y0[P.id[i]] = P.col(P.position, 1)[i];
