@@ -47,7 +47,7 @@ void require_same_outputs(const fs::path& a, const fs::path& b, long min_frames 
 
 /// Run `config` with checkpoints every `every` steps into a, copy a to b without its summary,
 /// resume b from the checkpoint of step `from`, compare.
-void check_resume(const std::string& config, const std::string& extra, long every, long from) {
+void check_resume_once(const std::string& config, const std::string& extra, long every, long from) {
   loam_test::TempDir a("ckpt_a"), b("ckpt_b");
   const std::string ck =
       " --set 'output.checkpoint={every_steps: " + std::to_string(every) + ", keep: 100}' ";
@@ -69,36 +69,36 @@ void check_resume(const std::string& config, const std::string& extra, long ever
   CHECK(loam_test::slurp(a.path / name).size() > 0);
 }
 
+/// check_resume_once at 1 and at 2 threads.
+void check_resume(const std::string& config, const std::string& extra, long every, long from) {
+  for (const char* threads : {"1", "2"})
+    check_resume_once(config, std::string("--threads ") + threads + " " + extra, every, from);
+}
+
 }  // namespace
 
 TEST_CASE("a resumed single-phase run is bitwise the uninterrupted one, 1 and 2 threads",
           "[checkpoint]") {
   // configs/vibrating_bar.yaml: 10 100 steps, frames every 101 steps; the checkpoint of step
   // 7 500 lies between two frames. Its reference (vibrating_bar) carries state (crossings).
-  for (const char* threads : {"1", "2"})
-    check_resume("vibrating_bar.yaml", std::string("--threads ") + threads, 500, 7500);
+  check_resume("vibrating_bar.yaml", "", 500, 7500);
 }
 
 TEST_CASE("a resumed APIC run (affine_moment) is bitwise the uninterrupted one, 1 and 2 threads",
           "[checkpoint][apic]") {
   // configs/granular_collapse_2d.yaml on 0.02 m cells with transfer: apic and gimp (about 9000
   // steps to t = 1 s): the checkpoint of step 4000 carries every particle's B_p.
-  for (const char* threads : {"1", "2"})
-    check_resume("granular_collapse_2d.yaml",
-                 std::string("--threads ") + threads +
-                     " --set grid.cell_size=0.02 --set shape_function=gimp --set "
-                     "scheme.transfer=apic --set scheme.flip=1",
-                 2000, 4000);
+  check_resume("granular_collapse_2d.yaml",
+               "--set grid.cell_size=0.02 --set shape_function=gimp --set "
+               "scheme.transfer=apic --set scheme.flip=1",
+               2000, 4000);
 }
 
 TEST_CASE("a resumed two-phase run is bitwise the uninterrupted one, 1 and 2 threads",
           "[checkpoint]") {
   // configs/seed001_terzaghi.yaml (two_phase_single_point, terzaghi reference) to t = 0.1 s.
-  for (const char* threads : {"1", "2"})
-    check_resume(
-        "seed001_terzaghi.yaml",
-        std::string("--threads ") + threads + " --set time.end=0.1 --set output.every_time=0.02",
-        1000, 7000);
+  check_resume("seed001_terzaghi.yaml", "--set time.end=0.1 --set output.every_time=0.02", 1000,
+               7000);
 }
 
 TEST_CASE("a run resumed within a stage is bitwise the uninterrupted one, 1 and 2 threads",
@@ -107,8 +107,7 @@ TEST_CASE("a run resumed within a stage is bitwise the uninterrupted one, 1 and 
   // activated; to step 1710) and excavate (deactivated). The checkpoint of step 1000 lies
   // within the build stage: the resumed run must neither activate the body again nor lose the
   // stage's static window, records or plugins.
-  for (const char* threads : {"1", "2"})
-    check_resume("construction_column_1d.yaml", std::string("--threads ") + threads, 500, 1000);
+  check_resume("construction_column_1d.yaml", "", 500, 1000);
 }
 
 TEST_CASE(
@@ -119,22 +118,17 @@ TEST_CASE(
   // the region sink removes liquid points (ids, the mass balance), and sheet_pile_seepage
   // accumulates its time series (verify.series, verify.csv) across the checkpoint. 2D, so at 2
   // threads points of same-coloured slabs do share cells after the move.
-  for (const char* threads : {"1", "2"})
-    check_resume("seed000_piping.yaml",
-                 std::string("--threads ") + threads +
-                     " --set grid.cell_size=0.25 --set time.end=1 --set output.every_time=0.25",
-                 500, 1500);
+  check_resume("seed000_piping.yaml",
+               "--set grid.cell_size=0.25 --set time.end=1 --set output.every_time=0.25", 500,
+               1500);
 }
 
 TEST_CASE("a resumed double-point run is bitwise the uninterrupted one, 1 and 2 threads",
           "[checkpoint][double_point]") {
   // Its cell sums after the move run in point order (framework/cell_sums.hpp), so 2 threads are
   // deterministic too.
-  for (const char* threads : {"1", "2"})
-    check_resume(
-        "terzaghi_double_point.yaml",
-        std::string("--threads ") + threads + " --set time.end=0.05 --set output.every_time=0.01",
-        1000, 4000);
+  check_resume("terzaghi_double_point.yaml", "--set time.end=0.05 --set output.every_time=0.01",
+               1000, 4000);
 }
 
 TEST_CASE("a resumed blast (absorbing free_field faces, blast_wave) is bitwise the same",
@@ -142,11 +136,8 @@ TEST_CASE("a resumed blast (absorbing free_field faces, blast_wave) is bitwise t
   // configs/seed002_blast_3d.yaml on 2 m cells to 0.01 s (25 steps): the absorbing faces'
   // free-field reactions of the first step and the reference's probe series cross the
   // checkpoint of step 10.
-  for (const char* threads : {"1", "2"})
-    check_resume("seed002_blast_3d.yaml",
-                 std::string("--threads ") + threads +
-                     " --set grid.cell_size=2 --set time.end=0.01 --set output.every_time=0.002",
-                 5, 10);
+  check_resume("seed002_blast_3d.yaml",
+               "--set grid.cell_size=2 --set time.end=0.01 --set output.every_time=0.002", 5, 10);
 }
 
 TEST_CASE("an unstable run checkpoints its last good state and resuming it fails the same way",
@@ -288,10 +279,8 @@ TEST_CASE(
   // The quick variant of configs/seed002_slope_frictional.yaml (1 m cells), resumed at step
   // 5000, inside the stage after the strength drop: slope_failure carries every point's last
   // position and last fast sample (time_to_rest) and its series across the checkpoint.
-  for (const char* threads : {"1", "2"})
-    check_resume("seed002_slope_frictional.yaml",
-                 std::string("--threads ") + threads +
-                     " --set grid.cell_size=1 --set stages.3.duration=10"
-                     " --set stages.0.static_speed=1e-4 --set stages.1.static_speed=1e-4",
-                 500, 5000);
+  check_resume("seed002_slope_frictional.yaml",
+               "--set grid.cell_size=1 --set stages.3.duration=10"
+               " --set stages.0.static_speed=1e-4 --set stages.1.static_speed=1e-4",
+               500, 5000);
 }
