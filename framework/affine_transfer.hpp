@@ -30,6 +30,20 @@
 // light nodes hold their points' own affine velocities. So with linear tents the field holds C_p
 // (`gradient_form()`), the scheme stores it from its USF gradient pass, and schemes without USF
 // refuse the combination; angular momentum is then kept only approximately (the tests print it).
+//
+// The Taylor particle-in-cell transfer (TPIC; Nakamura, Matsumura & Mizutani 2023, Comput.
+// Methods Appl. Mech. Engrg. 403, 115720) is the same P2G with the particle's velocity gradient
+// C_p in place of B_p D_p^-1, the first-order Taylor expansion of the particle's velocity field:
+//   G2P: v_p = sum_I N_Ip v_I,   C_p = sum_I v_I grad N_Ip^T,
+//   P2G: (m v)_I = sum_p m_p N_Ip (v_p + C_p (x_I - x_p)).
+// No inertia D_p and no inverse. For multilinear tents N_Ip D_p^-1 (x_I - x_p) = grad N_Ip, so
+// APIC already is TPIC there (and takes it from the USF pass, above). For the other shape
+// functions C_p D_p differs from B_p (interior quadratic B-splines, a particle h/4 from its
+// nearest node: for the node 1.25 h away grad N = -0.25/h, N D_p^-1 (x_I - x_p) = -0.156/h), so
+// TPIC conserves angular momentum only approximately; tests/test_apic.cpp prints its drift beside
+// APIC's. Fu, Guo, Gast, Jiang & Teran (2017, "A polynomial particle-in-cell method", ACM TOG 36)
+// is also cited for higher-order affine transfers: that is PolyPIC, which adds polynomial modes
+// beyond the affine one to APIC; it is not built here.
 #include <Eigen/Dense>
 #include <string>
 #include <vector>
@@ -52,16 +66,26 @@ class AffineTransfer {
     Eigen::Matrix<double, D, D> inertia;
   };
 
-  /// Node coordinates (x_I - x_p without divisions) and the form: B_p, or C_p for shape
-  /// functions whose stencil does not cover the particle's domain (linear tents).
-  void setup(const Grid<D>& grid, const ShapeFunction<D>& shape) {
-    gradient_form_ = !shape.stencil_covers_domain();
+  /// The transfer's name in a scheme's `transfer` key: apic or tpic.
+  static bool is_affine(const std::string& transfer) {
+    return transfer == "apic" || transfer == "tpic";
+  }
+
+  /// Node coordinates (x_I - x_p without divisions) and the form: B_p (APIC), or C_p for TPIC
+  /// (`taylor`) and for shape functions whose stencil does not cover the particle's domain
+  /// (linear tents, either transfer: the header).
+  void setup(const Grid<D>& grid, const ShapeFunction<D>& shape, bool taylor) {
+    usf_gradient_ = !shape.stencil_covers_domain();
+    gradient_form_ = taylor || usf_gradient_;
     node_x_.resize(grid.num_nodes * D);
     for (size_t n = 0; n < grid.num_nodes; ++n)
       for (int d = 0; d < D; ++d) node_x_[n * D + size_t(d)] = grid.node_coord(n, d);
   }
-  /// Whether the particles carry C_p (linear tents, the header) rather than B_p.
+  /// Whether the particles carry C_p (TPIC, linear tents) rather than APIC's B_p.
   bool gradient_form() const { return gradient_form_; }
+  /// Whether C_p is the velocity gradient of USF's P2G field, stored by the scheme's USF
+  /// gradient pass (linear tents: the header), rather than taken at the G2P.
+  bool needs_usf() const { return usf_gradient_; }
   /// The shape function's stencil fits (else: a located error by the scheme).
   static bool fits(const ShapeFunction<D>& shape) {
     return shape.max_nodes_per_particle() <= kMaxEntries;
@@ -139,11 +163,19 @@ class AffineTransfer {
     for (int d = 0; d < D; ++d) r[d] += a[d];
   }
 
-  /// G2P of stencil entry k: B += w v_I (x_I - x_p)^T (nothing in the gradient form, whose C_p
-  /// the scheme's gradient pass stores).
-  LOAM_FORCE_INLINE void add_moment(double w, const double* vI, const double* dx,
-                                    double (&B)[D][D]) const {
-    if (gradient_form_) return;
+  /// G2P of stencil entry k of block particle p: APIC's B += w v_I (x_I - x_p)^T, TPIC's
+  /// C += v_I grad N^T (nothing with linear tents, whose C_p the USF gradient pass stores).
+  LOAM_FORCE_INLINE void add_moment(const StencilBlock<D>& st, int k, int p, const double* vI,
+                                    const double* dx, double (&B)[D][D]) const {
+    if (usf_gradient_) return;
+    if (gradient_form_) {
+      for (int j = 0; j < D; ++j) {
+        const double g = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
+        for (int d = 0; d < D; ++d) B[d][j] += vI[d] * g;
+      }
+      return;
+    }
+    const double w = st.w[size_t(k) * kBlock + size_t(p)];
     for (int d = 0; d < D; ++d)
       for (int j = 0; j < D; ++j) B[d][j] += w * vI[d] * dx[j];
   }
@@ -154,10 +186,15 @@ class AffineTransfer {
     std::vector<std::string> names;
     for (int i = 0; i < D; ++i)
       for (int j = 0; j < D; ++j) names.push_back(std::string(1, "xyz"[i]) + "xyz"[j]);
+    if (usf_gradient_)
+      return {name, D * D, "1/s",
+              "APIC or TPIC with linear tents (update: usf): C_p, the gradient of the P2G " + what +
+                  " field at the particle; the particle's field is v_p + C_p (x - x_p)",
+              names};
     if (gradient_form_)
       return {name, D * D, "1/s",
-              "APIC with linear tents (update: usf): C_p, the gradient of the P2G " + what +
-                  " field at the particle; the particle's field is v_p + C_p (x - x_p)",
+              "TPIC's C_p = sum_I v_I grad N_Ip^T of the " + what +
+                  " (Nakamura et al. 2023): the particle's field is v_p + C_p (x - x_p)",
               names};
     return {name, D * D, "m^2/s",
             "APIC's B_p = sum_I N_Ip v_I (x_I - x_p)^T of the " + what +
@@ -167,7 +204,8 @@ class AffineTransfer {
   }
 
  private:
-  bool gradient_form_ = false;
+  bool gradient_form_ = false;  // C_p (TPIC, linear tents), not B_p
+  bool usf_gradient_ = false;   // C_p from the USF gradient pass (linear tents)
   std::vector<double> node_x_;  // num_nodes * D
 };
 

@@ -69,21 +69,24 @@ inline void add_flip_param(Schema& s) {
       .max(1);
 }
 
-/// `flip` and `transfer` of a scheme that offers APIC (framework/affine_transfer.hpp): transfer:
-/// apic replaces the FLIP/PIC blend, so it takes flip 1 only.
+/// `flip` and `transfer` of a scheme that offers the affine transfers (framework/
+/// affine_transfer.hpp): apic and tpic replace the FLIP/PIC blend, so they take flip 1 only.
 inline void add_transfer_params(Schema& s, const std::string& apic_note = "") {
   add_flip_param(s);
-  s.choice("transfer", {"flip", "apic"},
-           "particle-grid velocity transfer: flip (the FLIP/PIC blend of `flip`) or apic "
+  s.choice("transfer", {"flip", "apic", "tpic"},
+           "particle-grid velocity transfer: flip (the FLIP/PIC blend of `flip`), apic "
            "(affine particle-in-cell, Jiang et al. 2015: each particle carries an affine "
-           "velocity matrix; no PIC dissipation, no FLIP noise" +
+           "velocity matrix; no PIC dissipation, no FLIP noise) or tpic (Taylor particle-in-cell, "
+           "Nakamura et al. 2023: the affine matrix is the particle's velocity gradient from the "
+           "grid, no inertia tensor; angular momentum kept approximately" +
                apic_note + ")")
       .def("flip");
   s.check([](const Params& p, Diagnostics& d) {
-    if (p.text("transfer") == "apic" && p.real("flip") != 1.0)
+    const std::string t = p.text("transfer");
+    if (t != "flip" && p.real("flip") != 1.0)
       d.error(p.where("flip"), p.path("flip"),
-              "flip blends FLIP and PIC; transfer: apic replaces both (remove flip or set it "
-              "to 1)");
+              "flip blends FLIP and PIC; transfer: " + t +
+                  " replaces both (remove flip or set it to 1)");
   });
 }
 

@@ -3,9 +3,10 @@
 // force computation (USF), after the grid update (USL), or after re-mapping the updated particle
 // momentum to the grid (MUSL, the default; least noisy for near-empty nodes).
 //
-// `transfer: apic`: the affine particle-in-cell transfer of Jiang et al. (2015) with every
-// update variant (framework/affine_transfer.hpp has the equations and why linear tents take it
-// with update: usf only); the field affine_moment holds B_p (C_p with linear tents).
+// `transfer: apic` or `tpic`: the affine particle-in-cell transfers (APIC, Jiang et al. 2015;
+// TPIC, Nakamura et al. 2023) with every update variant (framework/affine_transfer.hpp has the
+// equations and why linear tents take them with update: usf only); the field affine_moment holds
+// APIC's B_p, or C_p (TPIC, linear tents).
 #include <omp.h>
 
 #include <algorithm>
@@ -59,12 +60,13 @@ class SinglePhase : public Scheme<D> {
       : params_(p),
         update_(p.text("update")),
         flip_(p.real("flip")),
-        apic_(p.text("transfer") == "apic"),
+        transfer_(p.text("transfer")),
+        affine_on_(AffineTransfer<D>::is_affine(transfer_)),
         sets_(p.strings("sets")) {}
 
-  /// APIC's affine matrix is part of the particle velocity field (a velocity reset zeroes it).
+  /// The affine matrix is part of the particle velocity field (a velocity reset zeroes it).
   std::vector<std::string> velocity_fields() const override {
-    return apic_ ? std::vector<std::string>{"affine_moment"} : std::vector<std::string>{};
+    return affine_on_ ? std::vector<std::string>{"affine_moment"} : std::vector<std::string>{};
   }
 
   std::vector<SetDeclaration> particle_sets() const override {
@@ -78,17 +80,18 @@ class SinglePhase : public Scheme<D> {
     vel_.assign(sim.grid.num_nodes * D, 0.0);
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch&) {});
-    if (!apic_) return;
-    affine_.setup(sim.grid, *sim.shape);
+    if (!affine_on_) return;
+    affine_.setup(sim.grid, *sim.shape, transfer_ == "tpic");
     B_ = sim.request_field(affine_.field_info("affine_moment", "velocity"));
-    if (affine_.gradient_form() && update_ != "usf")
+    if (affine_.needs_usf() && update_ != "usf")
       diag.error(params_.where("transfer"), params_.path("transfer"),
-                 "transfer: apic with linear tents needs update: usf (C_p is the velocity "
-                 "gradient of the P2G field; with musl or usl the run loses its rotation or "
-                 "blows up: framework/affine_transfer.hpp); or use gimp, bspline2 or cpdi");
+                 "transfer: " + transfer_ +
+                     " with linear tents needs update: usf (C_p is the velocity gradient of the "
+                     "P2G field; with musl or usl the run loses its rotation or blows up: "
+                     "framework/affine_transfer.hpp); or use gimp, bspline2 or cpdi");
     if (!AffineTransfer<D>::fits(*sim.shape))
       diag.error(params_.where("transfer"), params_.path("transfer"),
-                 "transfer: apic handles stencils of up to " +
+                 "transfer: " + transfer_ + " handles stencils of up to " +
                      std::to_string(AffineTransfer<D>::kMaxEntries) +
                      " nodes; this shape function uses " +
                      std::to_string(sim.shape->max_nodes_per_particle()));
@@ -120,9 +123,10 @@ class SinglePhase : public Scheme<D> {
   Params params_;
   std::string update_;
   double flip_;
-  bool apic_;
-  int B_ = -1;                // APIC's B_p (D x D, row-major; field affine_moment), or -1
-  AffineTransfer<D> affine_;  // APIC's per-entry algebra (framework/affine_transfer.hpp)
+  std::string transfer_;      // flip, apic or tpic
+  bool affine_on_;            // an affine transfer (apic or tpic)
+  int B_ = -1;                // B_p or C_p (D x D, row-major; field affine_moment), or -1
+  AffineTransfer<D> affine_;  // the affine per-entry algebra (framework/affine_transfer.hpp)
   std::vector<std::string> sets_;
   int F_ = -1;                // deformation gradient handle, or -1
   std::vector<double> node_;  // num_nodes * S
@@ -150,7 +154,8 @@ class SinglePhase : public Scheme<D> {
     } else {
       // USL: gradient, move and velocity update from the updated grid record in one pass (APIC:
       // its G2P first, at the positions before the move; the pass then only moves).
-      if (apic_) sim.timed("g2p_velocity", [&] { update_velocities<NPP, false, false>(sim, dt); });
+      if (affine_on_)
+        sim.timed("g2p_velocity", [&] { update_velocities<NPP, false, false>(sim, dt); });
       sim.timed("g2p_gradient_stress", [&] { update_stresses<NPP, Gradient::kUpdated>(sim, dt); });
     }
     sim.max_speed = max_speed(scratch_);
@@ -185,7 +190,7 @@ class SinglePhase : public Scheme<D> {
   template <int NPP, bool REMAP, bool MOVE>
   void update_velocities(Simulation<D>& sim, double dt) {
     auto f = [&](ParticleSet<D>& s, size_t b, int c, int t) {
-      if (apic_)
+      if (affine_on_)
         update_velocity_apic<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
       else
         update_velocity<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
@@ -400,11 +405,11 @@ class SinglePhase : public Scheme<D> {
         const double w = st.w[kp];
         const double* vI = g + size_t(st.node[kp]) * S + kMomentum;
         for (int d = 0; d < D; ++d) vp[d] += w * vI[d];
-        affine_.add_moment(w, vI, as.dx[k], B);
+        affine_.add_moment(st, k, p, vI, as.dx[k], B);
       }
       double v2 = 0, mv[D], mC[D][D];
       const double mp = P.col(P.mass)[i];
-      if (!affine_.gradient_form()) affine_.store(P, B_, i, B);  // linear: the USF gradient pass
+      if (!affine_.needs_usf()) affine_.store(P, B_, i, B);  // linear: the USF gradient pass
       for (int d = 0; d < D; ++d) {
         P.col(P.velocity, d)[i] = vp[d];
         mv[d] = mp * vp[d];
@@ -448,7 +453,7 @@ class SinglePhase : public Scheme<D> {
     const double* vel = kFromRecord ? node_.data() + kMomentum : vel_.data();
     const size_t vstride = kFromRecord ? S : D;
     const double flip = flip_;
-    const bool apic = apic_;  // USL with APIC: the velocities are updated already
+    const bool apic = affine_on_;  // USL with APIC: the velocities are updated already
     const HeldFaces<D> walls = sim.held_faces;
     double max_v2 = sc.max_v2;
     for (int p = 0; p < count; ++p) {
@@ -465,7 +470,7 @@ class SinglePhase : public Scheme<D> {
         }
       }
       store_velocity_gradient<D>(l, L, p);
-      if (MODE == Gradient::kCurrent && B_ >= 0 && affine_.gradient_form())  // linear: C_p
+      if (MODE == Gradient::kCurrent && B_ >= 0 && affine_.needs_usf())  // linear: C_p
         affine_.store(P, B_, b + size_t(p), l);
       update_volume_and_deformation<D>(l, dt, V[p], F, p);
       if constexpr (kMove)

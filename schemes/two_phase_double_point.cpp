@@ -140,7 +140,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       : drag_(Registry::instance().create<Drag, D>(p.section("drag"))),
         n0_(p.real("porosity")),
         flip_(p.real("flip")),
-        apic_(p.text("transfer") == "apic"),
+        transfer_(p.text("transfer")),
+        affine_on_(AffineTransfer<D>::is_affine(transfer_)),
         transfer_where_(p.where("transfer")),
         transfer_path_(p.path("transfer")),
         smooth_(p.text("pressure_smoothing") == "cell"),
@@ -151,7 +152,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   int phases() const override { return 2; }
   /// APIC's affine matrix is part of each point's velocity field (a velocity reset zeroes it).
   std::vector<std::string> velocity_fields() const override {
-    return apic_ ? std::vector<std::string>{"affine_moment"} : std::vector<std::string>{};
+    return affine_on_ ? std::vector<std::string>{"affine_moment"} : std::vector<std::string>{};
   }
   std::vector<SetDeclaration> particle_sets() const override {
     return {{"solid", "soil grains: the skeleton, effective stress, solid mass (1 - n) rho_s V"},
@@ -186,22 +187,23 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
     initialize_particles(sim, sim.sets[kSolid], 0, sim.sets[kSolid].size());
-    if (apic_) setup_apic(sim, diag);
+    if (affine_on_) setup_apic(sim, diag);
     if (diag.ok()) fill_pores(sim);
   }
 
-  /// transfer: apic: every point keeps B_p of its phase's velocity (solid points of v, liquid
-  /// points of w). Linear tents need USF's gradient (framework/affine_transfer.hpp); this scheme
-  /// is MUSL only: refused.
+  /// transfer: apic or tpic: every point keeps B_p (C_p) of its phase's velocity (solid points
+  /// of v, liquid points of w). Linear tents need USF's gradient (framework/affine_transfer.hpp);
+  /// this scheme is MUSL only: refused.
   void setup_apic(Simulation<D>& sim, Diagnostics& diag) {
-    affine_.setup(sim.grid, *sim.shape);
+    affine_.setup(sim.grid, *sim.shape, transfer_ == "tpic");
     B_ = sim.request_field(
         affine_.field_info("affine_moment", "point's own phase velocity (solid v, liquid w)"));
-    if (affine_.gradient_form() || !AffineTransfer<D>::fits(*sim.shape))
+    if (affine_.needs_usf() || !AffineTransfer<D>::fits(*sim.shape))
       diag.error(transfer_where_, transfer_path_,
-                 "transfer: apic in this scheme needs gimp, bspline2 or cpdi (linear tents take "
-                 "APIC with update: usf only, which this scheme does not offer: "
-                 "framework/affine_transfer.hpp)");
+                 "transfer: " + transfer_ +
+                     " in this scheme needs gimp, bspline2 or cpdi (linear tents take the affine "
+                     "transfers with update: usf only, which this scheme does not offer: "
+                     "framework/affine_transfer.hpp)");
   }
 
   /// Solid points: porosity n0, solid mass (1 - n0) rho_s V, in contact. Liquid points (a
@@ -275,7 +277,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   static constexpr double kMinPorosity = 1e-3;
   std::unique_ptr<Drag<D>> drag_;
   double n0_, flip_;
-  bool apic_;
+  std::string transfer_;     // flip, apic or tpic
+  bool affine_on_;           // an affine transfer (apic or tpic)
   Location transfer_where_;  // for set-up errors about `transfer`
   std::string transfer_path_;
   int B_ = -1;                // APIC: each point's B_p of its own phase's velocity, or -1
@@ -492,7 +495,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         body[d] = ms[p] * sim.gravity[size_t(d)] + fe;
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * P.col(P.stress, voigt_index(d, j))[i];
       }
-      if (apic_) affine_matrix(P, st, p, i, npp, ms[p], as, mC);
+      if (affine_on_) affine_matrix(P, st, p, i, npp, ms[p], as, mC);
       const double vq = V[p] * sc.Q[size_t(p)], vs = (1 - n[p]) * V[p];
       cell_solid_[particle_cell(sim.grid, P, i)] += vs;  // in the stencil: race-free
       for (int k = 0; k < npp; ++k) {
@@ -502,9 +505,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         r[kMs] += w * ms[p];
         r[kQ] += w * vq;
         r[kN] += w * vs;
-        if (apic_) AffineTransfer<D>::add_momentum(w, as.dx[k], mv, mC, r + kV);
+        if (affine_on_) AffineTransfer<D>::add_momentum(w, as.dx[k], mv, mC, r + kV);
         for (int d = 0; d < D; ++d) {
-          if (!apic_) r[kV + d] += w * mv[d];
+          if (!affine_on_) r[kV + d] += w * mv[d];
           double f = w * body[d];
           for (int j = 0; j < D; ++j)
             f -= sv[d][j] * st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
@@ -563,15 +566,15 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         body[d] = mw[p] * sim.gravity[size_t(d)] + fe;
         for (int j = 0; j < D; ++j) sv[d][j] = Vmix * P.col(P.stress, voigt_index(d, j))[i];
       }
-      if (apic_) affine_matrix(P, st, p, i, npp, mw[p], as, mC);
+      if (affine_on_) affine_matrix(P, st, p, i, npp, mw[p], as, mC);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
         double* r = g + size_t(st.node[kp]) * S;
         r[kMw] += w * mw[p];
-        if (apic_) AffineTransfer<D>::add_momentum(w, as.dx[k], mv, mC, r + kW);
+        if (affine_on_) AffineTransfer<D>::add_momentum(w, as.dx[k], mv, mC, r + kW);
         for (int d = 0; d < D; ++d) {
-          if (!apic_) r[kW + d] += w * mv[d];
+          if (!affine_on_) r[kW + d] += w * mv[d];
           r[kFw + d] += w * body[d];
           double f = 0;
           for (int j = 0; j < D; ++j)
@@ -696,7 +699,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       const size_t i = b + size_t(p);
       double vg[D] = {}, ag[D] = {}, B[D][D] = {};
       // B_p = sum_I N_Ip v_I (x_I - x_p)^T at x^n (framework/affine_transfer.hpp)
-      if (apic_) affine_.stencil(P, st, p, i, npp, as);
+      if (affine_on_) affine_.stencil(P, st, p, i, npp, as);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
@@ -705,17 +708,17 @@ class TwoPhaseDoublePoint : public Scheme<D> {
           vg[d] += w * r[kv + d];
           ag[d] += w * r[ka + d];
         }
-        if (apic_) affine_.add_moment(w, r + kv, as.dx[k], B);
+        if (affine_on_) affine_.add_moment(st, k, p, r + kv, as.dx[k], B);
       }
       double v2 = 0, vp[D];
       for (int d = 0; d < D; ++d) {
         double& v = P.col(P.velocity, d)[i];
-        v = vp[d] = apic_ ? vg[d] : flip_pic(flip, v, dt, ag[d], vg[d]);
+        v = vp[d] = affine_on_ ? vg[d] : flip_pic(flip, v, dt, ag[d], vg[d]);
         move[size_t(p) * D + size_t(d)] = dt * vg[d];
         v2 += vp[d] * vp[d];
       }
       max_v2 = std::max(max_v2, v2);
-      if (apic_) {  // the re-map carries the affine momentum too
+      if (affine_on_) {  // the re-map carries the affine momentum too
         affine_.store(P, B_, i, B);
         double mv[D], mC[D][D];
         for (int d = 0; d < D; ++d) mv[d] = m[p] * vp[d];

@@ -106,14 +106,15 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         Kw_(p.real("water_bulk_modulus")),
         flip_(p.real("flip")),
         musl_(p.text("update") == "musl"),
-        apic_(p.text("transfer") == "apic"),
+        transfer_(p.text("transfer")),
+        affine_on_(AffineTransfer<D>::is_affine(transfer_)),
         transfer_where_(p.where("transfer")),
         transfer_path_(p.path("transfer")),
         smooth_(p.text("pressure_smoothing") == "cell") {}
 
   int phases() const override { return 2; }
   std::vector<std::string> velocity_fields() const override {
-    if (apic_) return {"water_velocity", "affine_moment", "water_affine_moment"};
+    if (affine_on_) return {"water_velocity", "affine_moment", "water_affine_moment"};
     return {"water_velocity"};
   }
   std::vector<SetDeclaration> particle_sets() const override {
@@ -139,20 +140,21 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     if (musl_) remap_.assign(sim.grid.num_nodes * 2 * D, 0.0);
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
-    if (apic_) setup_apic(sim, diag);
+    if (affine_on_) setup_apic(sim, diag);
   }
 
-  /// transfer: apic: B_p fields of both phases. Linear tents need USF's gradient (see
-  /// framework/affine_transfer.hpp), which this scheme does not have: refused.
+  /// transfer: apic or tpic: B_p (C_p) fields of both phases. Linear tents need USF's gradient
+  /// (see framework/affine_transfer.hpp), which this scheme does not have: refused.
   void setup_apic(Simulation<D>& sim, Diagnostics& diag) {
-    affine_.setup(sim.grid, *sim.shape);
+    affine_.setup(sim.grid, *sim.shape, transfer_ == "tpic");
     Bs_ = sim.request_field(affine_.field_info("affine_moment", "solid velocity"));
     Bw_ = sim.request_field(affine_.field_info("water_affine_moment", "water velocity"));
-    if (affine_.gradient_form() || !AffineTransfer<D>::fits(*sim.shape))
+    if (affine_.needs_usf() || !AffineTransfer<D>::fits(*sim.shape))
       diag.error(transfer_where_, transfer_path_,
-                 "transfer: apic in this scheme needs gimp, bspline2 or cpdi (linear tents take "
-                 "APIC with update: usf only, which this scheme does not offer: "
-                 "framework/affine_transfer.hpp)");
+                 "transfer: " + transfer_ +
+                     " in this scheme needs gimp, bspline2 or cpdi (linear tents take the affine "
+                     "transfers with update: usf only, which this scheme does not offer: "
+                     "framework/affine_transfer.hpp)");
   }
 
   /// Porosity n0, solid mass (1 - n0) rho_s V (the material density is rho_s), water velocity
@@ -262,7 +264,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   std::unique_ptr<Drag<D>> drag_;
   double n0_, Kw_, flip_, rho_w_ = 1000;
   bool musl_;
-  bool apic_;
+  std::string transfer_;     // flip, apic or tpic
+  bool affine_on_;           // an affine transfer (apic or tpic)
   Location transfer_where_;  // for set-up errors about `transfer`
   std::string transfer_path_;
   int Bs_ = -1, Bw_ = -1;     // APIC: B_p of the solid and the water velocity, or -1
@@ -359,7 +362,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       const double mw = n[p] * rho_w_ * V[p];
       double vs[D], vw[D], body[D], sv[D][D], msv[D] = {}, mwv[D] = {}, mCs[D][D] = {},
                                               mCw[D][D] = {};
-      if (apic_) {
+      if (affine_on_) {
         affine_.stencil(P, st, p, i, npp, as);
         affine_momenta(P, i, ms[p], mw, as, msv, mwv, mCs, mCw);
       }
@@ -383,12 +386,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         double gr[D];
         for (int j = 0; j < D; ++j)
           gr[j] = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
-        if (apic_) {  // the phases' affine momenta
+        if (affine_on_) {  // the phases' affine momenta
           AffineTransfer<D>::add_momentum(w, as.dx[k], msv, mCs, r + kV);
           AffineTransfer<D>::add_momentum(w, as.dx[k], mwv, mCw, r + kW);
         }
         for (int d = 0; d < D; ++d) {
-          if (!apic_) {
+          if (!affine_on_) {
             r[kV + d] += w * ms[p] * vs[d];
             r[kW + d] += w * mw * vw[d];
           }
@@ -507,15 +510,15 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       max_v2 = std::max(max_v2, velocity_update<false>(sim, P, st, p, i, npp, dt, &move_[i * D],
-                                                       apic_ ? &as : nullptr));
+                                                       affine_on_ ? &as : nullptr));
       const double ms = P.col(P.mass)[i], mw = P.col(n_)[i] * rho_w_ * P.col(P.volume)[i];
       double msv[D] = {}, mwv[D] = {}, mCs[D][D] = {}, mCw[D][D] = {};
       // The re-map carries the affine momenta, with D_p at x^n (as the scatter).
-      if (apic_) affine_momenta(P, i, ms, mw, as, msv, mwv, mCs, mCw);
+      if (affine_on_) affine_momenta(P, i, ms, mw, as, msv, mwv, mCs, mCw);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         double* r = remap_.data() + size_t(st.node[kp]) * 2 * D;
-        if (apic_) {
+        if (affine_on_) {
           AffineTransfer<D>::add_momentum(st.w[kp], as.dx[k], msv, mCs, r);
           AffineTransfer<D>::add_momentum(st.w[kp], as.dx[k], mwv, mCw, r + D);
         } else {
@@ -568,8 +571,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         acc_w[d] += w * r[kFw + d];
       }
       if (as) {
-        affine_.add_moment(w, r + kV, as->dx[k], Bs);
-        affine_.add_moment(w, r + kW, as->dx[k], Bw);
+        affine_.add_moment(st, k, p, r + kV, as->dx[k], Bs);
+        affine_.add_moment(st, k, p, r + kW, as->dx[k], Bw);
       }
     }
     if (as) {
@@ -614,7 +617,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       // (the stencil was evaluated at x^n above, so moving here does not change it).
       if constexpr (!REMAPPED)
         max_v2 = std::max(max_v2, velocity_update<true>(sim, P, st, p, i, npp, dt, nullptr,
-                                                        apic_ ? &as : nullptr));
+                                                        affine_on_ ? &as : nullptr));
       double ls[D][D] = {}, lw[D][D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);

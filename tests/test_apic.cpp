@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli.hpp"
+#include "disks.hpp"
 #include "sim_helpers.hpp"
 
 namespace {
@@ -17,19 +18,9 @@ namespace {
 constexpr double kOmega = 1.0;  // rad/s
 constexpr double kCentre = 1.0;
 
-/// A free elastic disk of radius 0.5 m about (1, 1) in a 2 m grid, no gravity, no boundaries.
+/// The free elastic disk (tests/disks.hpp) under the single-phase scheme with `transfer`.
 std::string disk(const std::string& shape, const std::string& transfer) {
-  return "grid: {extent: [2, 2], cell_size: 0.1}\n"
-         "gravity: [0, 0]\n"
-         "shape_function: " +
-         shape + "\nscheme: {type: single_phase, " + transfer +
-         "}\n"
-         "bodies:\n"
-         "  - name: disk\n"
-         "    generator: {type: sphere, center: [1, 1], radius: 0.5}\n"
-         "    particles_per_cell: 2\n"
-         "    material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 1000}\n"
-         "time: {end: 100, cfl: 0.5}\n";
+  return loam_test::disk_yaml(shape, "type: single_phase, " + transfer);
 }
 
 /// Angular momentum about the centre, with APIC's affine part: the particle's share of the grid's
@@ -157,7 +148,7 @@ TEST_CASE("apic: bad transfer input gives located errors", "[apic][transfer][bad
     std::string scheme, message;
   };
   const Case cases[] = {
-      {"{type: single_phase, transfer: tpic}", "scheme.transfer: unknown value 'tpic'"},
+      {"{type: single_phase, transfer: polypic}", "scheme.transfer: unknown value 'polypic'"},
       // Linear tents (the default) take APIC with update: usf only (affine_transfer.hpp).
       {"{type: single_phase, transfer: apic}",
        "scheme.transfer: transfer: apic with linear tents needs update: usf"},

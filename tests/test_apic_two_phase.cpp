@@ -13,28 +13,21 @@
 #include <string>
 
 #include "cli.hpp"
+#include "disks.hpp"
 #include "sim_helpers.hpp"
 
 namespace {
 
 constexpr double kOmega = 1.0, kCentre = 1.0;
 
-/// A free saturated elastic disk of radius 0.5 m about (1, 1), no gravity, no boundaries.
+/// The free saturated disk (tests/disks.hpp) under the single-point scheme; `scheme` is
+/// appended inside its mapping.
 std::string saturated_disk(const std::string& shape, const std::string& scheme) {
-  return "grid: {extent: [2, 2], cell_size: 0.1}\n"
-         "gravity: [0, 0]\n"
-         "shape_function: " +
-         shape +
-         "\nscheme: {type: two_phase_single_point, porosity: 0.4, water_bulk_modulus: 2.0e7, "
-         "drag: {type: darcy, hydraulic_conductivity: 1.0e-3}" +
-         scheme +
-         "}\n"
-         "bodies:\n"
-         "  - name: disk\n"
-         "    generator: {type: sphere, center: [1, 1], radius: 0.5}\n"
-         "    particles_per_cell: 2\n"
-         "    material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 2650}\n"
-         "time: {end: 100, cfl: 0.5}\n";
+  return loam_test::disk_yaml(shape,
+                              "type: two_phase_single_point, porosity: 0.4, water_bulk_modulus: "
+                              "2.0e7, drag: {type: darcy, hydraulic_conductivity: 1.0e-3}" +
+                                  scheme,
+                              "2650");
 }
 
 /// A point's masses and position at the start of a step: its own mass (P.mass) and, in the
@@ -194,7 +187,7 @@ TEST_CASE("apic two-phase: bad transfer input gives located errors",
       {"linear", "transfer: apic", "scheme.transfer: transfer: apic in this scheme needs gimp"},
       {"gimp", "transfer: apic, flip: 0.98",
        "scheme.flip: flip blends FLIP and PIC; transfer: apic replaces both"},
-      {"gimp", "transfer: tpic", "scheme.transfer: unknown value 'tpic'"},
+      {"gimp", "transfer: polypic", "scheme.transfer: unknown value 'polypic'"},
   };
   for (const auto& c : cases)
     loam_test::check_located_error(
@@ -208,26 +201,6 @@ TEST_CASE("apic two-phase: bad transfer input gives located errors",
         "run.yaml:2:", c.message);
 }
 
-namespace {
-
-/// A free saturated disk in the double-point scheme: solid points (elastic) and liquid points
-/// (water, K_w = 20 MPa) at the same places, radius 0.5 m about (1, 1), no gravity.
-std::string double_point_disk(const std::string& shape, const std::string& scheme) {
-  return "grid: {extent: [2, 2], cell_size: 0.1}\ngravity: [0, 0]\nshape_function: " + shape +
-         "\nscheme: {type: two_phase_double_point, porosity: 0.4, drag: {type: darcy, "
-         "hydraulic_conductivity: 1.0e-3}" +
-         scheme +
-         "}\nbodies:\n"
-         "  - {name: grains, set: solid, generator: {type: sphere, center: [1, 1], radius: 0.5}, "
-         "material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 2650}}\n"
-         "  - {name: water, set: liquid, generator: {type: sphere, center: [1, 1], radius: 0.5}, "
-         "material: {type: newtonian_fluid, bulk_modulus: 2.0e7, viscosity: 1.0e-3, density: "
-         "1000}}\n"
-         "time: {end: 100, cfl: 0.5}\n";
-}
-
-}  // namespace
-
 TEST_CASE("apic double point: a spinning saturated disk keeps its angular momentum",
           "[apic][transfer][double_point]") {
   // Solid and liquid points each carry B_p of their phase's velocity; both transfers, the drag
@@ -235,9 +208,9 @@ TEST_CASE("apic double point: a spinning saturated disk keeps its angular moment
   // step at the masses and positions of the step's P2G (target 1e-12 of L, 300 steps), and over
   // the run against FLIP and PIC (PIC: above 0.5).
   for (const char* shape : {"gimp", "bspline2"}) {
-    const auto apic = spin(double_point_disk(shape, ", transfer: apic"), 300);
-    const auto flip = spin(double_point_disk(shape, ""), 300);
-    const auto pic = spin(double_point_disk(shape, ", flip: 0"), 300);
+    const auto apic = spin(loam_test::double_point_disk_yaml(shape, ", transfer: apic"), 300);
+    const auto flip = spin(loam_test::double_point_disk_yaml(shape, ""), 300);
+    const auto pic = spin(loam_test::double_point_disk_yaml(shape, ", flip: 0"), 300);
     std::printf(
         "double-point spinning disk, %s, 300 steps: APIC per-step change %.2e, drift %.2e; "
         "FLIP per-step %.2e, drift %.2e; PIC drift %.2e\n",
