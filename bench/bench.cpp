@@ -83,16 +83,17 @@ std::string bench_scene(const std::string& scene, const std::string& shape,
                  "hydraulic_conductivity: 1.0e-4}}");
     return saturate_with_liquid_points(yaml);
   }
-  // The apic_ prefix: any scene with APIC transfers (transfer: apic added to its scheme), with
+  // The apic_ and tpic_ prefixes: any scene with that affine transfer added to its scheme, with
   // the --update given (linear tents: usf only).
-  const std::string apic = "apic_";
-  if (scene.rfind(apic, 0) == 0) {
-    std::string yaml = bench_scene(scene.substr(apic.size()), shape, update);
+  for (const std::string transfer : {"apic", "tpic"}) {
+    const std::string affine = transfer + "_";
+    if (scene.rfind(affine, 0) != 0) continue;
+    std::string yaml = bench_scene(scene.substr(affine.size()), shape, update);
     const size_t line = yaml.find("scheme: {");
     const size_t end = line == std::string::npos ? line : yaml.find('\n', line);
     const size_t close = end == std::string::npos ? end : yaml.rfind('}', end);
     if (yaml.empty() || close == std::string::npos || close < line) return "";
-    yaml.insert(close, ", transfer: apic");  // the scheme map's last brace
+    yaml.insert(close, ", transfer: " + transfer);  // the scheme map's last brace
     return yaml;
   }
   const bool two_phase = scene.rfind("two_phase_", 0) == 0;

@@ -82,8 +82,9 @@ int main(int argc, char** argv) {
                     "scenes (default: elastic_block_2d elastic_block_3d; two_phase_ prefix: "
                     "the same block saturated, two_phase_single_point scheme; double_point_ "
                     "prefix: saturated with a liquid point beside every solid point, "
-                    "two_phase_double_point scheme; apic_ prefix: the scene with transfer: apic "
-                    "(e.g. apic_two_phase_elastic_block_2d; linear tents need --update usf); "
+                    "two_phase_double_point scheme; apic_ and tpic_ prefixes: the scene with "
+                    "transfer: apic or tpic (e.g. apic_two_phase_elastic_block_2d; linear tents "
+                    "need --update usf); "
                     "_two_sets suffix: the block over two sets)");
   bench->add_option("--update", bench_opt.update, "musl, usl or usf");
   bench->add_option("--shape-functions", bench_opt.shapes,
