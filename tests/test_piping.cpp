@@ -347,3 +347,56 @@ TEST_CASE("seed 000 piping scene: the exit gradient follows Harr's and the bed h
   CHECK(v["heave"].get<double>() > 1e-3);
   CHECK(std::fabs(s["mass"]["balance"].get<double>()) <= 1e-9 * s["mass"]["final"].get<double>());
 }
+
+TEST_CASE("sheet_pile_seepage: pipe_fraction counts the fluidised rows along the pile",
+          "[piping][reference]") {
+  // The mechanism of the pipe measure (plugins/references/sheet_pile_seepage.cpp): sand 2 m deep,
+  // the pile at x = 2 m embedded d = 1 m, 0.25 m cells: four rows between the tip (y = 1) and the
+  // surface (y = 2), the face band 0.25 m wide (the exit window's). Grains marked fluidised
+  // (contact 0) in the band's two lower rows give 0.5; the same upstream of the pile, beyond
+  // the band or below the tip give 0 (and the 2 x 2 grains of the cell beyond the band still count
+  // as fluidised points downstream); every row of the band gives 1.
+  const std::string yaml = R"(
+grid: {origin: [0, 0], extent: [4, 3], cell_size: 0.25}
+gravity: [0, -9.81]
+scheme: {type: two_phase_double_point, porosity: 0.43, max_porosity: 0.5,
+         drag: {type: darcy, hydraulic_conductivity: 1.0e-2}}
+bodies:
+  - {name: sand, set: solid, generator: {type: box, min: [0, 0], max: [4, 2]},
+     material: {type: linear_elastic, E: 1.0e8, nu: 0.3, density: 2650}}
+  - {name: water, set: liquid, generator: {type: box, min: [0, 0], max: [4, 2.5]},
+     material: {type: newtonian_fluid, bulk_modulus: 2.0e8, viscosity: 1.0e-3, density: 1000}}
+time: {end: 1}
+)";
+  auto sim = loam_test::make_simulation<2>(yaml);
+  auto& S = sim->sets[0].particles;
+  const int contact = S.find("contact");
+  REQUIRE(contact >= 0);
+  // Mark the grains whose position passes `where`, then sample: {pipe_fraction, fluidised}.
+  auto measure = [&](auto where) {
+    for (size_t i = 0; i < S.size(); ++i)
+      S.col(contact)[i] = where(S.col(S.position, 0)[i], S.col(S.position, 1)[i]) ? 0.0 : 1.0;
+    auto ref = loam_test::make_reference<2>(
+        *sim, "{type: sheet_pile_seepage, body: sand, pile: 2, depth: 1, every: 1}");
+    ref->sample(*sim);
+    const auto m = ref->metrics(*sim);
+    return std::make_pair(m.at("pipe_fraction"), m.at("fluidised_points"));
+  };
+  const auto lower =
+      measure([](double x, double y) { return x > 2 && x < 2.25 && y < 1.5 && y > 1; });
+  const auto upstream = measure([](double x, double y) { return x < 2 && x > 1.75 && y > 1; });
+  const auto beyond = measure([](double x, double y) { return x > 2.25 && x < 2.5 && y > 1.75; });
+  const auto below = measure([](double x, double y) { return x > 2 && x < 2.25 && y < 1; });
+  const auto all = measure([](double x, double y) { return x > 2 && x < 2.25 && y > 1; });
+  std::printf(
+      "pipe_fraction: lower rows %.3g (0.5), upstream %.3g (0), beyond the band %.3g (0) with %g "
+      "fluidised points (4), below the tip %.3g (0), every row %.3g (1)\n",
+      lower.first, upstream.first, beyond.first, beyond.second, below.first, all.first);
+  CHECK(lower.first == 0.5);
+  CHECK(upstream.first == 0);
+  CHECK(upstream.second == 0);
+  CHECK(beyond.first == 0);
+  CHECK(beyond.second == 4);
+  CHECK(below.first == 0);
+  CHECK(all.first == 1);
+}

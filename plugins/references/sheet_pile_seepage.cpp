@@ -24,15 +24,19 @@
 //   liquid points' own pressures scatter by far more than their cell means (with linear hats a
 //   cell's nodal forces see only its sum of V p; docs/verification.md I), so this one is noisy;
 // - the fluidised points of the bed (a `contact` field of 0) downstream of the pile, and the heave:
-//   the rise of the highest grain of the bed within d/2 downstream of the pile.
+//   the rise of the highest grain of the bed within d/2 downstream of the pile;
+// - the pipe along the pile: pipe_fraction, the share of the embedded depth d (in rows one cell
+//   high, from the tip to the surface; heaved grains above it count in the top row) holding a
+//   fluidised grain within the exit window's width of the downstream face. 1 is a fluidised
+//   channel from the tip to the exit.
 // Metrics: exit_gradient_error (the slope through the origin of the seepage exit gradient
 // against Harr's over the intact samples, ΔH ≥ ΔH_c/4 and before the critical head, minus 1),
 // critical_head (ΔH at the first sample whose seepage exit gradient reaches i_c: the quick
 // condition next to the pile, zero effective stress at the exit, Harr's and Terzaghi's
 // criterion; NaN if never), critical_head_fluidised (ΔH at the first sample with a grain
 // fluidised at n_max downstream; NaN if none), critical_head_harr (π d i_c),
-// critical_head_prism, critical_head_error (critical_head against Harr), heave and
-// fluidised_points at the end, critical_gradient.
+// critical_head_prism, critical_head_error (critical_head against Harr), heave,
+// fluidised_points and pipe_fraction at the end, critical_gradient.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -198,10 +202,19 @@ class SheetPileSeepage : public Reference<D> {
     const auto [i_seep, i_seep_harr] = seepage_exit_gradient(sim, P, S, dH);
     // Fluidised grains downstream and the heave next to the pile.
     long fluidised = 0;
+    const double row = sim.grid.cell[D - 1];
+    std::vector<char> pipe_rows(size_t(std::max(1L, std::lround(d_ / row))), 0);
     if (S.has(contact_))
-      for (size_t i = 0; i < S.size(); ++i)
-        if (S.body[i] == body_ && S.col(contact_)[i] == 0 && S.col(S.position, 0)[i] > x_pile_)
-          ++fluidised;
+      for (size_t i = 0; i < S.size(); ++i) {
+        const double x = S.col(S.position, 0)[i], y = S.col(S.position, D - 1)[i];
+        if (S.body[i] != body_ || S.col(contact_)[i] != 0 || x <= x_pile_) continue;
+        ++fluidised;
+        if (x > x_pile_ + width_ || y < surface_ - d_) continue;
+        const long r = std::min(long(pipe_rows.size()) - 1, long((y - (surface_ - d_)) / row));
+        pipe_rows[size_t(r)] = 1;
+      }
+    const double pipe =
+        double(std::count(pipe_rows.begin(), pipe_rows.end(), 1)) / double(pipe_rows.size());
     time_.push_back(sim.time);
     head_.push_back(dH);
     up_.push_back(h_up);
@@ -211,6 +224,7 @@ class SheetPileSeepage : public Reference<D> {
     exit_p_.push_back(i_exit);
     harr_p_.push_back(i_harr);
     fluidised_.push_back(double(fluidised));
+    pipe_.push_back(pipe);
     heave_.push_back(strip_top(sim) - heave_base_);
     if (i_seep >= i_c_ && !std::isfinite(critical_)) critical_ = dH;
     if (fluidised > 0 && !std::isfinite(fluidised_head_)) fluidised_head_ = dH;
@@ -240,7 +254,8 @@ class SheetPileSeepage : public Reference<D> {
             {"head_difference", head_.back()},
             {"exit_gradient", exit_.back()},
             {"heave", heave_.back()},
-            {"fluidised_points", fluidised_.back()}};
+            {"fluidised_points", fluidised_.back()},
+            {"pipe_fraction", pipe_.back()}};
   }
 
   std::vector<std::pair<std::string, std::vector<double>>> series() const override {
@@ -253,13 +268,14 @@ class SheetPileSeepage : public Reference<D> {
             {"exit_gradient_pressure", exit_p_},
             {"exit_gradient_pressure_harr", harr_p_},
             {"fluidised_points", fluidised_},
+            {"pipe_fraction", pipe_},
             {"heave", heave_}};
   }
 
   bool save_state(std::vector<double>& s) const override {
     s = {clock_.next, critical_, fluidised_head_, double(time_.size())};
-    for (const auto* v :
-         {&time_, &head_, &up_, &down_, &exit_, &harr_, &exit_p_, &harr_p_, &fluidised_, &heave_})
+    for (const auto* v : {&time_, &head_, &up_, &down_, &exit_, &harr_, &exit_p_, &harr_p_,
+                          &fluidised_, &heave_, &pipe_})
       s.insert(s.end(), v->begin(), v->end());
     return true;
   }
@@ -267,8 +283,8 @@ class SheetPileSeepage : public Reference<D> {
     clock_.next = s.at(0), critical_ = s.at(1), fluidised_head_ = s.at(2);
     const long n = long(s.at(3));
     long k = 4;
-    for (auto* v :
-         {&time_, &head_, &up_, &down_, &exit_, &harr_, &exit_p_, &harr_p_, &fluidised_, &heave_}) {
+    for (auto* v : {&time_, &head_, &up_, &down_, &exit_, &harr_, &exit_p_, &harr_p_, &fluidised_,
+                    &heave_, &pipe_}) {
       v->assign(s.begin() + k, s.begin() + k + n);
       k += n;
     }
@@ -357,6 +373,7 @@ class SheetPileSeepage : public Reference<D> {
   double fluidised_head_ = std::nan("");  // ΔH at the first fluidised grain
   int body_ = -1, set_ = -1, pressure_ = -1, contact_ = -1;
   std::vector<double> time_, head_, up_, down_, exit_, harr_, fluidised_, heave_;
+  std::vector<double> pipe_;             // pipe_fraction per sample
   std::vector<double> exit_p_, harr_p_;  // the exit gradient from the pressures, and Harr's
   double k_ = 0;                         // Darcy hydraulic conductivity (m/s)
   int porosity_ = -1;                    // the soil points' porosity field
