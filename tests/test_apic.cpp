@@ -167,80 +167,88 @@ TEST_CASE("apic: bad transfer input gives located errors", "[apic][transfer][bad
         "run.yaml:2:", c.message);
 }
 
-TEST_CASE("apic: the vibrating bar's energy drift is at least 5x smaller than with flip 0.98",
-          "[apic][transfer]") {
+TEST_CASE(
+    "apic and tpic: the vibrating bar's energy drift is at least 5x smaller than with flip 0.98",
+    "[apic][tpic][transfer]") {
   // configs/vibrating_bar.yaml (docs/verification.md A: 10 periods of the first mode, 1D), its
   // reference's energy_drift (largest |E - E0| / E0 of the particles' kinetic plus strain energy)
-  // with transfer: apic against the FLIP/PIC blend flip: 0.98 that granular scenes use, for gimp
-  // and bspline2 (issue 17: at least 5x smaller). Measured 2026-12-04: gimp 0.64 % against
-  // 14.0 %, bspline2 1.01 % against 18.0 % (pure FLIP: 0.51 % with gimp).
+  // with transfer: apic and tpic against the FLIP/PIC blend flip: 0.98 that granular scenes use,
+  // for gimp and bspline2 (issue 17: at least 5x smaller). Measured 2026-12-04: APIC gimp
+  // 0.64 % against 14.0 %, bspline2 1.01 % against 18.0 % (pure FLIP: 0.51 % with gimp); TPIC
+  // 0.70 % and 1.13 %. Linear tents take the affine transfers with update: usf (the scheme's
+  // header), where TPIC is APIC, so both runs use it there and only APIC runs.
   for (const char* shape : {"gimp", "bspline2", "linear"}) {
-    // Linear tents take APIC with update: usf (the scheme's header), so both runs use it there.
+    const bool linear = std::string(shape) == "linear";
     const std::string base = std::string("--threads 1 --set shape_function=") + shape +
-                             (std::string(shape) == "linear" ? " --set scheme.update=usf" : "");
-    loam_test::TempDir a("vibrating_bar_apic"), f("vibrating_bar_flip098");
-    const auto sa =
-        loam_test::run_scene("vibrating_bar.yaml", a.path, base + " --set scheme.transfer=apic");
+                             (linear ? " --set scheme.update=usf" : "");
+    loam_test::TempDir f("vibrating_bar_flip098");
     const auto sf =
         loam_test::run_scene("vibrating_bar.yaml", f.path, base + " --set scheme.flip=0.98");
-    const double da = sa["verify"]["energy_drift"], df = sf["verify"]["energy_drift"];
-    std::printf(
-        "vibrating bar, %s: energy drift APIC %.3f %%, flip 0.98 %.3f %% (%.1fx); period "
-        "error APIC %.2e, flip 0.98 %.2e\n",
-        shape, 100 * da, 100 * df, df / da, sa["verify"]["period_error"].get<double>(),
-        sf["verify"]["period_error"].get<double>());
-    CHECK(5 * da < df);
+    const double df = sf["verify"]["energy_drift"];
+    for (const std::string transfer : {"apic", "tpic"}) {
+      if (linear && transfer == "tpic") continue;
+      loam_test::TempDir a("vibrating_bar_" + transfer);
+      const auto sa = loam_test::run_scene("vibrating_bar.yaml", a.path,
+                                           base + " --set scheme.transfer=" + transfer);
+      const double da = sa["verify"]["energy_drift"];
+      std::printf(
+          "vibrating bar, %s: energy drift %s %.3f %%, flip 0.98 %.3f %% (%.1fx); period "
+          "error %s %.2e, flip 0.98 %.2e\n",
+          shape, transfer.c_str(), 100 * da, 100 * df, df / da, transfer.c_str(),
+          sa["verify"]["period_error"].get<double>(), sf["verify"]["period_error"].get<double>());
+      CHECK(5 * da < df);
+    }
   }
 }
 
-TEST_CASE("apic: a rigid translation across cells gives no stress, for every shape function",
-          "[apic][transfer][invariance]") {
+TEST_CASE("apic and tpic: a rigid translation across cells gives no stress, every shape function",
+          "[apic][tpic][transfer][invariance]") {
   // A free bar (1D) and a free block (2D) translating at 1 m/s across 10 cells: the velocity
-  // field is uniform, so B_p (C_p with linear tents) stays zero, the velocity stays 1 m/s and no
-  // stress appears, also as the free ends enter new cells (with linear tents B_p D_p^-1 at a new
-  // position once blew this up: framework/affine_transfer.hpp; they run with update: usf).
-  // Targets: |v - 1| < 1e-12 m/s,
-  // |sigma| < 1e-6 Pa (E = 1 MPa).
-  for (const char* shape : {"linear", "gimp", "bspline2", "cpdi"}) {
-    for (int dim : {1, 2}) {
-      const std::string yaml =
-          std::string(dim == 1 ? "grid: {extent: [3], cell_size: 0.1}\ngravity: [0]\n"
-                               : "grid: {extent: [3, 1], cell_size: 0.1}\ngravity: [0, 0]\n") +
-          "shape_function: " + shape + "\nscheme: {type: single_phase, transfer: apic" +
-          (std::string(shape) == "linear" ? ", update: usf" : "") +
-          "}\nbodies:\n  - name: bar\n"
-          "    generator: {type: box, min: " +
-          (dim == 1 ? "[0.5], max: [1.3]}" : "[0.5, 0.3], max: [1.3, 0.7]}") +
-          "\n    particles_per_cell: 2\n    velocity: " + (dim == 1 ? "[1]" : "[1, 0]") +
-          "\n    material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 1000}\n"
-          "time: {end: 10, cfl: 0.5}\n";
-      double max_dv = 0, max_sig = 0, moved = 0;
-      auto check = [&](auto sim) {
-        auto& P = sim->sets[0].particles;
-        const double x0 = P.col(P.position, 0)[0];
-        loam_test::advance(*sim, 1);
-        for (int n = 0; n < 5000 && P.col(P.position, 0)[0] - x0 < 1.0; ++n) {  // ~650 needed
-          loam_test::advance(*sim, 1);
-          for (size_t i = 0; i < P.size(); ++i) {
-            max_dv = std::max(max_dv, std::fabs(P.col(P.velocity, 0)[i] - 1));
-            for (int c = 0; c < P.NS; ++c)
-              max_sig = std::max(max_sig, std::fabs(P.col(P.stress, c)[i]));
+  // field is uniform, so B_p (APIC) and C_p = sum_I v grad N_Ip^T (TPIC; linear tents) stay zero
+  // to round-off, the velocity stays 1 m/s and no stress appears, also as the free ends enter
+  // new cells (with linear tents B_p D_p^-1 at a new position once blew this up:
+  // framework/affine_transfer.hpp; they run with update: usf). Every step is checked, the first
+  // included. Targets: |v - 1| < 1e-12 m/s, |sigma| < 1e-6 Pa (E = 1 MPa).
+  for (const std::string transfer : {"apic", "tpic"})
+    for (const char* shape : {"linear", "gimp", "bspline2", "cpdi"}) {
+      for (int dim : {1, 2}) {
+        const std::string yaml =
+            std::string(dim == 1 ? "grid: {extent: [3], cell_size: 0.1}\ngravity: [0]\n"
+                                 : "grid: {extent: [3, 1], cell_size: 0.1}\ngravity: [0, 0]\n") +
+            "shape_function: " + shape + "\nscheme: {type: single_phase, transfer: " + transfer +
+            (std::string(shape) == "linear" ? ", update: usf" : "") +
+            "}\nbodies:\n  - name: bar\n"
+            "    generator: {type: box, min: " +
+            (dim == 1 ? "[0.5], max: [1.3]}" : "[0.5, 0.3], max: [1.3, 0.7]}") +
+            "\n    particles_per_cell: 2\n    velocity: " + (dim == 1 ? "[1]" : "[1, 0]") +
+            "\n    material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 1000}\n"
+            "time: {end: 10, cfl: 0.5}\n";
+        double max_dv = 0, max_sig = 0, moved = 0;
+        auto check = [&](auto sim) {
+          auto& P = sim->sets[0].particles;
+          const double x0 = P.col(P.position, 0)[0];
+          for (int n = 0; n < 5000 && P.col(P.position, 0)[0] - x0 < 1.0; ++n) {  // ~650 needed
+            loam_test::advance(*sim, 1);
+            for (size_t i = 0; i < P.size(); ++i) {
+              max_dv = std::max(max_dv, std::fabs(P.col(P.velocity, 0)[i] - 1));
+              for (int c = 0; c < P.NS; ++c)
+                max_sig = std::max(max_sig, std::fabs(P.col(P.stress, c)[i]));
+            }
           }
-        }
-        moved = P.col(P.position, 0)[0] - x0;
-      };
-      if (dim == 1)
-        check(loam_test::make_simulation<1>(yaml));
-      else
-        check(loam_test::make_simulation<2>(yaml));
-      std::printf(
-          "rigid translation, APIC, %s, %dD, %.2f m: max |v - 1| %.2e m/s, max |sigma| %.2e Pa\n",
-          shape, dim, moved, max_dv, max_sig);
-      CHECK(moved >= 1.0);
-      CHECK(max_dv < 1e-12);
-      CHECK(max_sig < 1e-6);
+          moved = P.col(P.position, 0)[0] - x0;
+        };
+        if (dim == 1)
+          check(loam_test::make_simulation<1>(yaml));
+        else
+          check(loam_test::make_simulation<2>(yaml));
+        std::printf(
+            "rigid translation, %s, %s, %dD, %.2f m: max |v - 1| %.2e m/s, max |sigma| %.2e Pa\n",
+            transfer.c_str(), shape, dim, moved, max_dv, max_sig);
+        CHECK(moved >= 1.0);
+        CHECK(max_dv < 1e-12);
+        CHECK(max_sig < 1e-6);
+      }
     }
-  }
 }
 
 TEST_CASE("apic: a stage's velocity reset zeroes the affine matrices, in every scheme",

@@ -265,17 +265,14 @@ time: {end: 3}
   CHECK(vmax <= 1e-2);
 }
 
-TEST_CASE("sheet_pile_seepage: the exit gradient is the seepage i = n (w - v) / k in the window",
-          "[piping][reference]") {
-  // The mechanism of the measurement (plugins/references/sheet_pile_seepage.cpp): a saturated
-  // sand box (n = 0.43, Darcy k = 1e-2 m/s) with the pile at x = 2 m, the water moving up at
-  // w = 3 mm/s and the skeleton at v = 1 mm/s. The window's exit gradient is
-  // n (w - v) / k = 0.43 * 2e-3 / 1e-2 = 0.086 to round-off, whatever the pressures; water at
-  // rest on a skeleton at rest gives 0. A conductivity given in `verify:` replaces the drag's.
-  const std::string yaml = R"(
+namespace {
+
+/// The reference tests' saturated sand box: sand 2 m deep (n = 0.43, n_max = 0.5, Darcy k =
+/// 1e-2 m/s) under 0.5 m of water, 4 m wide, 0.25 m cells; the pile is the reference's own.
+const std::string kSandBox = R"(
 grid: {origin: [0, 0], extent: [4, 3], cell_size: 0.25}
 gravity: [0, -9.81]
-scheme: {type: two_phase_double_point, porosity: 0.43,
+scheme: {type: two_phase_double_point, porosity: 0.43, max_porosity: 0.5,
          drag: {type: darcy, hydraulic_conductivity: 1.0e-2}}
 bodies:
   - {name: sand, set: solid, generator: {type: box, min: [0, 0], max: [4, 2]},
@@ -284,7 +281,17 @@ bodies:
      material: {type: newtonian_fluid, bulk_modulus: 2.0e8, viscosity: 1.0e-3, density: 1000}}
 time: {end: 1}
 )";
-  auto sim = loam_test::make_simulation<2>(yaml);
+
+}  // namespace
+
+TEST_CASE("sheet_pile_seepage: the exit gradient is the seepage i = n (w - v) / k in the window",
+          "[piping][reference]") {
+  // The mechanism of the measurement (plugins/references/sheet_pile_seepage.cpp): a saturated
+  // sand box (n = 0.43, Darcy k = 1e-2 m/s) with the pile at x = 2 m, the water moving up at
+  // w = 3 mm/s and the skeleton at v = 1 mm/s. The window's exit gradient is
+  // n (w - v) / k = 0.43 * 2e-3 / 1e-2 = 0.086 to round-off, whatever the pressures; water at
+  // rest on a skeleton at rest gives 0. A conductivity given in `verify:` replaces the drag's.
+  auto sim = loam_test::make_simulation<2>(kSandBox);
   const std::string verify = "{type: sheet_pile_seepage, body: sand, pile: 2, depth: 1, every: 1}";
   auto measure = [&](double w, double v, const std::string& spec) {
     for (int k = 0; k < 2; ++k) {
@@ -371,19 +378,7 @@ TEST_CASE("sheet_pile_seepage: pipe_fraction counts the fluidised rows along the
   // (contact 0) in the band's two lower rows give 0.5; the same upstream of the pile, beyond
   // the band or below the tip give 0 (and the 2 x 2 grains of the cell beyond the band still count
   // as fluidised points downstream); every row of the band gives 1.
-  const std::string yaml = R"(
-grid: {origin: [0, 0], extent: [4, 3], cell_size: 0.25}
-gravity: [0, -9.81]
-scheme: {type: two_phase_double_point, porosity: 0.43, max_porosity: 0.5,
-         drag: {type: darcy, hydraulic_conductivity: 1.0e-2}}
-bodies:
-  - {name: sand, set: solid, generator: {type: box, min: [0, 0], max: [4, 2]},
-     material: {type: linear_elastic, E: 1.0e8, nu: 0.3, density: 2650}}
-  - {name: water, set: liquid, generator: {type: box, min: [0, 0], max: [4, 2.5]},
-     material: {type: newtonian_fluid, bulk_modulus: 2.0e8, viscosity: 1.0e-3, density: 1000}}
-time: {end: 1}
-)";
-  auto sim = loam_test::make_simulation<2>(yaml);
+  auto sim = loam_test::make_simulation<2>(kSandBox);
   auto& S = sim->sets[0].particles;
   const int contact = S.find("contact");
   REQUIRE(contact >= 0);
