@@ -317,9 +317,9 @@ TEST_CASE("sheet_pile_seepage: the exit gradient is the seepage i = n (w - v) / 
 
 TEST_CASE(
     "seed 000 piping scene: the exit gradient follows Harr's, the bed heaves past dH_c, then "
-    "fluidises along the pile",
+    "fluidises along the pile until the pipe connects",
     "[piping][scene][full]") {
-  // configs/seed000_piping.yaml as shipped (0.125 m cells, GIMP, 30 s, about 16 min on 2
+  // configs/seed000_piping.yaml as shipped (0.125 m cells, GIMP, 50 s, about 35 min on 2
   // threads; docs/verification.md I). References: Harr's exit gradient measured at the same
   // cells as the seepage i = n (w - v) / k next to the pile. exit_gradient_error covers the
   // intact stage, before the quick condition. For this 0.25 m thick pile a Laplace solve gives
@@ -331,12 +331,14 @@ TEST_CASE(
   // pile stays put while dH < 2 m (heave < 0.1 mm) and rises after the quick condition: heave
   // > 1 mm at the end. Fluidisation (a grain at n_max) comes after the quick condition, and
   // the fluidised zone grows: more grains and more of the pile's depth at the end than at its
-  // first sample (measured: 1 grain and 1/8 of d at 19.4 s, 41 grains and 1/2 at 30 s).
+  // first sample (measured: 1 grain and 1/8 of d at 19.4 s, 41 grains and 1/2 at 30 s), and
+  // by the end it reaches from the tip to the exit: pipe_fraction 1 (the pipe; measured from
+  // 46.35 s in a 60-s run).
   loam_test::TempDir dir("piping_full");
   auto s = loam_test::run_scene("seed000_piping.yaml", dir.path, "--threads 2");
   const auto& v = s["verify"];
   const auto& se = v["series"];
-  double heave_intact = 0, first_points = 0, first_pipe = 0;
+  double heave_intact = 0, first_points = 0, first_pipe = 0, pipe_time = -1, pipe_head = -1;
   bool fluidised = false;
   for (size_t k = 0; k < se["time"].size(); ++k) {
     if (se["head_difference"][k].get<double>() < 2.0)
@@ -346,18 +348,22 @@ TEST_CASE(
       first_points = se["fluidised_points"][k];
       first_pipe = se["pipe_fraction"][k];
     }
+    if (pipe_time < 0 && se["pipe_fraction"][k].get<double>() >= 1.0) {
+      pipe_time = se["time"][k];
+      pipe_head = se["head_difference"][k];
+    }
   }
   std::printf(
-      "piping (0.125 m cells, GIMP, 30 s): exit_gradient_error %+.4f (thick pile -0.137 +- "
+      "piping (0.125 m cells, GIMP, 50 s): exit_gradient_error %+.4f (thick pile -0.137 +- "
       "0.1); critical head (quick condition) %s m against Harr's %.4f and the prism's %.4f; "
       "heave %.2e m while dH < 2 m, %.3f m at the end; first fluidised grain at dH = %s m "
-      "(%g grains, pipe fraction %.3f), at the end %g grains, pipe fraction %.3f; %ld steps, "
-      "%.0f s wall\n",
+      "(%g grains, pipe fraction %.3f), at the end %g grains, pipe fraction %.3f; pipe "
+      "connected at t = %.2f s (dH = %.3f m); %ld steps, %.0f s wall\n",
       v["exit_gradient_error"].get<double>(), v["critical_head"].dump().c_str(),
       v["critical_head_harr"].get<double>(), v["critical_head_prism"].get<double>(), heave_intact,
       v["heave"].get<double>(), v["critical_head_fluidised"].dump().c_str(), first_points,
-      first_pipe, v["fluidised_points"].get<double>(), v["pipe_fraction"].get<double>(),
-      s["steps"].get<long>(), s["wall_seconds"].get<double>());
+      first_pipe, v["fluidised_points"].get<double>(), v["pipe_fraction"].get<double>(), pipe_time,
+      pipe_head, s["steps"].get<long>(), s["wall_seconds"].get<double>());
   CHECK(std::fabs(v["exit_gradient_error"].get<double>() - (0.863 - 1)) <= 0.1);
   REQUIRE(v["critical_head"].is_number());
   CHECK(v["critical_head"].get<double>() > 2.0);
@@ -367,6 +373,7 @@ TEST_CASE(
   CHECK(v["critical_head_fluidised"].get<double>() > v["critical_head"].get<double>());
   CHECK(v["fluidised_points"].get<double>() > first_points);
   CHECK(v["pipe_fraction"].get<double>() > first_pipe);
+  CHECK(v["pipe_fraction"].get<double>() == 1.0);
   CHECK(std::fabs(s["mass"]["balance"].get<double>()) <= 1e-9 * s["mass"]["final"].get<double>());
 }
 
