@@ -10,8 +10,11 @@
 // P2G (and a MUSL re-map), with the inertia D_p = sum_I N_Ip (x_I - x_p)(x_I - x_p)^T of the
 // particle's current position:
 //   (m v)_I = sum_p m_p N_Ip (v_p + B_p D_p^-1 (x_I - x_p)).
-// D_p comes from the weights: h^2/4 I for interior quadratic B-splines, GIMP's and CPDI's from
-// their domain-averaged weights (invertible: a domain spans nodes). Keeping B_p, not
+// D_p comes from the weights: for tensor-product weights (gimp, bspline2) the shape function
+// gives x_I - x_p and D_p = diag(sum_j w_j dx_j^2) per axis from its axis values
+// (axis_stencil.hpp; h^2/4 per axis for interior quadratic B-splines), vectorised over the
+// block; for CPDI (and the offsets of linear tents) they come from the node coordinates, with
+// D_p's sum and inverse per particle (invertible: a domain spans nodes). Keeping B_p, not
 // C_p = B_p D_p^-1, and taking D_p where the particle is when it scatters is what conserves
 // angular momentum over the move for weights whose D_p changes with position. Linear and angular
 // momentum are conserved by the transfers; the affine part carries no PIC dissipation and no
@@ -60,10 +63,17 @@ class AffineTransfer {
   /// Entries of a stencil handled per particle (CPDI's widest, 4^D).
   static constexpr int kMaxEntries = ipow(4, D);
 
-  /// x_I - x_p of every stencil entry of a particle, and D_p's accumulation.
+  /// x_I - x_p of every stencil entry of a particle, and D_p^-1 (APIC's B_p form only).
   struct Stencil {
-    double dx[kMaxEntries][D];
-    Eigen::Matrix<double, D, D> inertia;
+    /// x_I - x_p of entry k along axis j: in the stencil block (its SoA layout, no copy) or
+    /// in `own` (computed from the node coordinates).
+    LOAM_FORCE_INLINE double dx(int k, int j) const {
+      return at[(size_t(k) * D + size_t(j)) * stride];
+    }
+    const double* at = own;
+    size_t stride = 1;
+    double own[kMaxEntries * D] = {};  // value-initialised: declared once per block
+    double inertia_inv[D][D] = {};
   };
 
   /// The transfer's name in a scheme's `transfer` key: apic or tpic.
@@ -91,29 +101,61 @@ class AffineTransfer {
     return shape.max_nodes_per_particle() <= kMaxEntries;
   }
 
-  /// x_I - x_p of every stencil entry of particle p (position xp), and D_p.
-  void stencil(const StencilBlock<D>& st, int p, int npp, const double* xp, Stencil& a) const {
-    a.inertia.setZero();
+  /// The shape function's stencil of a block for a pass that transfers the affine velocity:
+  /// it also asks for the offsets (and D_p^-1 for APIC's B_p form), which tensor-product shape
+  /// functions give from their axis values (StencilBlock::affine).
+  /// `on` false: the plain evaluation (a pass of a scheme run without an affine transfer).
+  void evaluate(const Simulation<D>& sim, const Particles<D>& P, size_t begin, int count,
+                StencilBlock<D>& st, bool on = true) const {
+    if (on) st.affine = gradient_form_ ? StencilBlock<D>::kOffsets : StencilBlock<D>::kInertia;
+    sim.shape->evaluate(sim.grid, P, begin, count, st);
+    st.affine = StencilBlock<D>::kNone;  // the other passes' evaluations need none
+  }
+
+  /// x_I - x_p of every stencil entry of particle p of the block (index i in P) and D_p^-1:
+  /// from the stencil block when its shape function gave them (AffineTransfer::evaluate), else
+  /// from the node coordinates (stencil_from_nodes).
+  LOAM_FORCE_INLINE void stencil(const Particles<D>& P, const StencilBlock<D>& st, int p, size_t i,
+                                 int npp, Stencil& a) const {
+    if (!st.has_affine) {
+      stencil_from_nodes(P, st, p, i, npp, a);
+      return;
+    }
+    a.at = st.dx.data() + p;
+    a.stride = kBlock;
+    if (gradient_form_) return;
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j)
+        a.inertia_inv[d][j] = d == j ? st.inertia_inv[size_t(d) * kBlock + size_t(p)] : 0.0;
+  }
+
+  /// The same from the node coordinates: D_p = sum_k N_k dx_k dx_k^T and its inverse (linear
+  /// tents, CPDI).
+  void stencil_from_nodes(const Particles<D>& P, const StencilBlock<D>& st, int p, size_t i,
+                          int npp, Stencil& a) const {
+    double xp[D];
+    for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
+    a.at = a.own;
+    a.stride = 1;
+    Eigen::Matrix<double, D, D> inertia = Eigen::Matrix<double, D, D>::Zero();
     for (int k = 0; k < npp; ++k) {
       const size_t kp = size_t(k) * kBlock + size_t(p);
       const double* xI = node_x_.data() + size_t(st.node[kp]) * D;
-      for (int d = 0; d < D; ++d) a.dx[k][d] = xI[d] - xp[d];
+      double* dx = a.own + size_t(k) * D;
+      for (int d = 0; d < D; ++d) dx[d] = xI[d] - xp[d];
       if (gradient_form_) continue;  // C_p needs no inertia
       for (int d = 0; d < D; ++d)
-        for (int j = 0; j < D; ++j) a.inertia(d, j) += st.w[kp] * a.dx[k][d] * a.dx[k][j];
+        for (int j = 0; j < D; ++j) inertia(d, j) += st.w[kp] * dx[d] * dx[j];
     }
-  }
-
-  /// The stencil geometry of particle p of the block (index i in P) at its current position.
-  void stencil(const Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
-               Stencil& a) const {
-    double xp[D];
-    for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
-    stencil(st, p, npp, xp, a);
+    if (gradient_form_) return;
+    const Eigen::Matrix<double, D, D> inv = inertia.inverse();
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) a.inertia_inv[d][j] = inv(d, j);
   }
 
   /// Particle i's B_p (or C_p) from its field `field` (D x D, row-major), and back.
-  static void load(const Particles<D>& P, int field, size_t i, double (&B)[D][D]) {
+  LOAM_FORCE_INLINE static void load(const Particles<D>& P, int field, size_t i,
+                                     double (&B)[D][D]) {
     for (int d = 0; d < D; ++d)
       for (int j = 0; j < D; ++j) B[d][j] = P.col(field, d * D + j)[i];
   }
@@ -123,50 +165,47 @@ class AffineTransfer {
   }
 
   /// mC = m B D^-1 of particle i from its field `field`, at the stencil geometry `a`.
-  void matrix(const Particles<D>& P, int field, size_t i, double m, const Stencil& a,
-              double (&mC)[D][D]) const {
+  LOAM_FORCE_INLINE void matrix(const Particles<D>& P, int field, size_t i, double m,
+                                const Stencil& a, double (&mC)[D][D]) const {
     double B[D][D];
     load(P, field, i, B);
     matrix(m, B, a, mC);
   }
 
   /// mC = m_p B_p D_p^-1 (B row-major); m_p C_p in the gradient form.
-  void matrix(double mp, const double (&B)[D][D], const Stencil& a, double (&mC)[D][D]) const {
+  LOAM_FORCE_INLINE void matrix(double mp, const double (&B)[D][D], const Stencil& a,
+                                double (&mC)[D][D]) const {
     if (gradient_form_) {
       for (int d = 0; d < D; ++d)
         for (int j = 0; j < D; ++j) mC[d][j] = mp * B[d][j];
       return;
     }
-    Eigen::Matrix<double, D, D> Bm;
     for (int d = 0; d < D; ++d)
-      for (int j = 0; j < D; ++j) Bm(d, j) = mp * B[d][j];
-    const Eigen::Matrix<double, D, D> C = Bm * a.inertia.inverse();
-    for (int d = 0; d < D; ++d)
-      for (int j = 0; j < D; ++j) mC[d][j] = C(d, j);
+      for (int j = 0; j < D; ++j) {
+        double c = 0;
+        for (int e = 0; e < D; ++e) c += mp * B[d][e] * a.inertia_inv[e][j];
+        mC[d][j] = c;
+      }
   }
 
-  /// The momentum stencil entry k sends to its node: w (m v_p + (m B D^-1)(x_I - x_p)).
-  LOAM_FORCE_INLINE static void momentum(double w, const double* dx, const double (&mv)[D],
-                                         const double (&mC)[D][D], double (&out)[D]) {
+  /// The momentum stencil entry k sends to its node, w (m v_p + (m B D^-1)(x_I - x_p)), added
+  /// to the node's slot r (D values).
+  LOAM_FORCE_INLINE static void add_momentum(double w, const Stencil& s, int k,
+                                             const double (&mv)[D], const double (&mC)[D][D],
+                                             double* r) {
+    double dx[D];
+    for (int j = 0; j < D; ++j) dx[j] = s.dx(k, j);
     for (int d = 0; d < D; ++d) {
       double a = mv[d];
       for (int j = 0; j < D; ++j) a += mC[d][j] * dx[j];
-      out[d] = w * a;
+      r[d] += w * a;
     }
-  }
-
-  /// The same momentum added to a node's slot r (D values).
-  LOAM_FORCE_INLINE static void add_momentum(double w, const double* dx, const double (&mv)[D],
-                                             const double (&mC)[D][D], double* r) {
-    double a[D];
-    momentum(w, dx, mv, mC, a);
-    for (int d = 0; d < D; ++d) r[d] += a[d];
   }
 
   /// G2P of stencil entry k of block particle p: APIC's B += w v_I (x_I - x_p)^T, TPIC's
   /// C += v_I grad N^T (nothing with linear tents, whose C_p the USF gradient pass stores).
   LOAM_FORCE_INLINE void add_moment(const StencilBlock<D>& st, int k, int p, const double* vI,
-                                    const double* dx, double (&B)[D][D]) const {
+                                    const Stencil& s, double (&B)[D][D]) const {
     if (usf_gradient_) return;
     if (gradient_form_) {
       for (int j = 0; j < D; ++j) {
@@ -177,7 +216,7 @@ class AffineTransfer {
     }
     const double w = st.w[size_t(k) * kBlock + size_t(p)];
     for (int d = 0; d < D; ++d)
-      for (int j = 0; j < D; ++j) B[d][j] += w * vI[d] * dx[j];
+      for (int j = 0; j < D; ++j) B[d][j] += w * vI[d] * s.dx(k, j);
   }
 
   /// The particle field holding B_p (or C_p), requested only when APIC is on. `name` and

@@ -14,9 +14,24 @@ struct AxisStencil {
   alignas(64) double w[D][M][kBlock];
   alignas(64) double dw[D][M][kBlock];
   alignas(64) int32_t node[D][M][kBlock];
+  alignas(64) double dx[D][M][kBlock];  // x_I - x_p along each axis, for the affine transfers
+
+  /// x_I - x_p along axis d of every entry, for the affine transfers (out.affine): the node
+  /// coordinate as Grid::node_coord forms it (origin + i h, i the clamped index of node[d]), so
+  /// the offsets are the same bits as from the node coordinates.
+  void offsets(const Grid<D>& g, int d, const double* x, int count, const StencilBlock<D>& out) {
+    if (out.affine == StencilBlock<D>::kNone) return;
+    const double o = g.origin[size_t(d)], h = g.cell[size_t(d)];
+    // node = i * stride exactly, so the double quotient is i exactly (and vectorises)
+    const double stride = double(g.node_stride[d]);
+    for (int j = 0; j < M; ++j)
+      for (int p = 0; p < count; ++p) dx[d][j][p] = (o + double(node[d][j][p]) / stride * h) - x[p];
+  }
 
   void tensor_product(int count, StencilBlock<D>& out) const {
     constexpr int K = ipow(M, D);
+    out.has_affine = out.affine != StencilBlock<D>::kNone;
+    if (out.has_affine) affine_product(count, out);
     for (int k = 0; k < K; ++k) {
       // Entry k is node j[0] along x, j[1] along y, ...: N = prod_d w_d, dN/dx_d = dw_d prod_e!=d
       // w_e. One fused loop per entry (node, weight and gradients); the outputs are restrict:
@@ -47,6 +62,33 @@ struct AxisStencil {
             if (e != d) gp *= wa[e][p];
           grad_k[size_t(d) * kBlock + size_t(p)] = gp;
         }
+      }
+    }
+  }
+
+ private:
+  /// The affine transfers' offsets of every entry and, with kInertia, D_p^-1. For weights that
+  /// are products of axis weights, D_p = sum_k N_k dx_k dx_k^T factors into axis moments
+  /// m_n(d) = sum_j w_dj dx_dj^n: D_dd = m_2(d) prod_(e != d) m_0(e) and D_de = m_1(d) m_1(e)
+  /// prod_(f != d, e) m_0(f). Partition of unity (m_0 = 1) and linear reproduction (m_1 = 0)
+  /// hold for the weights that use this (gimp and bspline2, their boundary-modified nodes
+  /// included), so D_p = diag(m_2(d)) up to round-off (h^2/4 per axis for interior quadratic
+  /// B-splines, as Jiang et al. 2015 give).
+  void affine_product(int count, StencilBlock<D>& out) const {
+    constexpr int K = ipow(M, D);
+    for (int k = 0; k < K; ++k)
+      for (int d = 0, r = k; d < D; ++d, r /= M) {
+        const double* a = dx[d][r % M];
+        double* __restrict o = out.dx.data() + (size_t(k) * D + size_t(d)) * kBlock;
+        for (int p = 0; p < count; ++p) o[p] = a[p];
+      }
+    if (out.affine != StencilBlock<D>::kInertia) return;
+    for (int d = 0; d < D; ++d) {
+      double* __restrict inv = out.inertia_inv.data() + size_t(d) * kBlock;
+      for (int p = 0; p < count; ++p) {
+        double m2 = 0;
+        for (int j = 0; j < M; ++j) m2 += w[d][j][p] * dx[d][j][p] * dx[d][j][p];
+        inv[p] = 1.0 / m2;
       }
     }
   }

@@ -29,11 +29,24 @@ struct StencilBlock {
   std::vector<double> w;      // [k*kBlock + p]
   std::vector<double> grad;   // [(k*D + d)*kBlock + p]
 
+  // The affine transfers' geometry (framework/affine_transfer.hpp). A pass that transfers an
+  // affine velocity sets `affine` before evaluating: kOffsets asks for x_I - x_p of every entry,
+  // kInertia also for D_p^-1. A tensor-product shape function fills them from its per-axis
+  // values (framework/axis_stencil.hpp) and sets `has_affine`; for the others AffineTransfer
+  // computes them from the node coordinates.
+  enum Affine { kNone = 0, kOffsets = 1, kInertia = 2 };
+  Affine affine = kNone;
+  bool has_affine = false;
+  std::vector<double> dx;           // [(k*D + d)*kBlock + p]: x_I - x_p
+  std::vector<double> inertia_inv;  // [d*kBlock + p]: 1 / D_p(d, d) (D_p diagonal)
+
   void allocate(int nodes_per_particle) {
     npp = nodes_per_particle;
     node.assign(size_t(npp) * kBlock, 0);
     w.assign(size_t(npp) * kBlock, 0.0);
     grad.assign(size_t(npp) * D * kBlock, 0.0);
+    dx.assign(size_t(npp) * D * kBlock, 0.0);
+    inertia_inv.assign(size_t(D) * kBlock, 0.0);
   }
 };
 

@@ -220,7 +220,7 @@ class SinglePhase : public Scheme<D> {
   void scatter(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
     Particles<D>& P = set.particles;
     StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
-    sim.shape->evaluate(sim.grid, P, b, count, st);
+    affine_.evaluate(sim, P, b, count, st, MOMENTUM && affine_on_);
     const int npp = NPP ? NPP : st.npp;
     const double* m = P.col(P.mass) + b;
     const double* V = P.col(P.volume) + b;
@@ -255,7 +255,7 @@ class SinglePhase : public Scheme<D> {
         if constexpr (MOMENTUM) {
           r[kMass] += w * mp;
           if (affine) {  // APIC: m_p (N v_p + B_p D_p^-1 N (x_I - x_p)), see the header
-            affine_.add_momentum(w, as.dx[k], mv, mC, r + kMomentum);
+            affine_.add_momentum(w, as, k, mv, mC, r + kMomentum);
           } else {
             for (int d = 0; d < D; ++d) r[kMomentum + d] += w * mv[d];
           }
@@ -389,7 +389,7 @@ class SinglePhase : public Scheme<D> {
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
-    sim.shape->evaluate(sim.grid, P, b, count, st);
+    affine_.evaluate(sim, P, b, count, st);
     const int npp = NPP ? NPP : st.npp;
     const double* g = node_.data();
     double* remap = vel_.data();
@@ -405,7 +405,7 @@ class SinglePhase : public Scheme<D> {
         const double w = st.w[kp];
         const double* vI = g + size_t(st.node[kp]) * S + kMomentum;
         for (int d = 0; d < D; ++d) vp[d] += w * vI[d];
-        affine_.add_moment(st, k, p, vI, as.dx[k], B);
+        affine_.add_moment(st, k, p, vI, as, B);
       }
       double v2 = 0, mv[D], mC[D][D];
       const double mp = P.col(P.mass)[i];
@@ -422,7 +422,7 @@ class SinglePhase : public Scheme<D> {
       affine_.matrix(mp, B, as, mC);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
-        affine_.add_momentum(st.w[kp], as.dx[k], mv, mC, remap + size_t(st.node[kp]) * D);
+        affine_.add_momentum(st.w[kp], as, k, mv, mC, remap + size_t(st.node[kp]) * D);
       }
     }
     sc.max_v2 = max_v2;

@@ -478,7 +478,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
-    sim.shape->evaluate(sim.grid, P, b, count, st);
+    affine_.evaluate(sim, P, b, count, st, affine_on_);
     const int npp = NPP ? NPP : st.npp;
     const double* ms = P.col(P.mass) + b;
     const double* V = P.col(P.volume) + b;
@@ -505,7 +505,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         r[kMs] += w * ms[p];
         r[kQ] += w * vq;
         r[kN] += w * vs;
-        if (affine_on_) AffineTransfer<D>::add_momentum(w, as.dx[k], mv, mC, r + kV);
+        if (affine_on_) AffineTransfer<D>::add_momentum(w, as, k, mv, mC, r + kV);
         for (int d = 0; d < D; ++d) {
           if (!affine_on_) r[kV + d] += w * mv[d];
           double f = w * body[d];
@@ -548,7 +548,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   void scatter_liquid(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
     Particles<D>& P = set.particles;
     StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
-    sim.shape->evaluate(sim.grid, P, b, count, st);
+    affine_.evaluate(sim, P, b, count, st, affine_on_);
     const int npp = NPP ? NPP : st.npp;
     const double* mw = P.col(P.mass) + b;
     const double* V = P.col(P.volume) + b;
@@ -572,7 +572,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         const double w = st.w[kp];
         double* r = g + size_t(st.node[kp]) * S;
         r[kMw] += w * mw[p];
-        if (affine_on_) AffineTransfer<D>::add_momentum(w, as.dx[k], mv, mC, r + kW);
+        if (affine_on_) AffineTransfer<D>::add_momentum(w, as, k, mv, mC, r + kW);
         for (int d = 0; d < D; ++d) {
           if (!affine_on_) r[kW + d] += w * mv[d];
           r[kFw + d] += w * body[d];
@@ -686,7 +686,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
-    sim.shape->evaluate(sim.grid, P, b, count, st);
+    affine_.evaluate(sim, P, b, count, st, affine_on_);
     const int npp = NPP ? NPP : st.npp;
     const int kv = phase == kSolid ? kV : kW, ka = phase == kSolid ? kF : kFw;
     const double* g = node_.data();
@@ -708,7 +708,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
           vg[d] += w * r[kv + d];
           ag[d] += w * r[ka + d];
         }
-        if (affine_on_) affine_.add_moment(st, k, p, r + kv, as.dx[k], B);
+        if (affine_on_) affine_.add_moment(st, k, p, r + kv, as, B);
       }
       double v2 = 0, vp[D];
       for (int d = 0; d < D; ++d) {
@@ -726,7 +726,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         for (int k = 0; k < npp; ++k) {
           const size_t kp = size_t(k) * kBlock + size_t(p);
           AffineTransfer<D>::add_momentum(
-              st.w[kp], as.dx[k], mv, mC,
+              st.w[kp], as, k, mv, mC,
               remap_.data() + size_t(st.node[kp]) * 2 * D + size_t(phase * D));
         }
         continue;

@@ -337,7 +337,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
-    sim.shape->evaluate(sim.grid, P, b, count, st);
+    affine_.evaluate(sim, P, b, count, st, affine_on_);
     const int npp = NPP ? NPP : st.npp;
     const double* ms = P.col(P.mass) + b;
     const double* V = P.col(P.volume) + b;
@@ -387,8 +387,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         for (int j = 0; j < D; ++j)
           gr[j] = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
         if (affine_on_) {  // the phases' affine momenta
-          AffineTransfer<D>::add_momentum(w, as.dx[k], msv, mCs, r + kV);
-          AffineTransfer<D>::add_momentum(w, as.dx[k], mwv, mCw, r + kW);
+          AffineTransfer<D>::add_momentum(w, as, k, msv, mCs, r + kV);
+          AffineTransfer<D>::add_momentum(w, as, k, mwv, mCw, r + kW);
         }
         for (int d = 0; d < D; ++d) {
           if (!affine_on_) {
@@ -503,7 +503,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
-    sim.shape->evaluate(sim.grid, P, b, count, st);
+    affine_.evaluate(sim, P, b, count, st, affine_on_);
     const int npp = NPP ? NPP : st.npp;
     double max_v2 = sc.max_v2;
     AffineStencil as;
@@ -519,8 +519,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         double* r = remap_.data() + size_t(st.node[kp]) * 2 * D;
         if (affine_on_) {
-          AffineTransfer<D>::add_momentum(st.w[kp], as.dx[k], msv, mCs, r);
-          AffineTransfer<D>::add_momentum(st.w[kp], as.dx[k], mwv, mCw, r + D);
+          AffineTransfer<D>::add_momentum(st.w[kp], as, k, msv, mCs, r);
+          AffineTransfer<D>::add_momentum(st.w[kp], as, k, mwv, mCw, r + D);
         } else {
           for (int d = 0; d < D; ++d) {
             r[d] += st.w[kp] * ms * P.col(P.velocity, d)[i];
@@ -571,8 +571,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         acc_w[d] += w * r[kFw + d];
       }
       if (as) {
-        affine_.add_moment(st, k, p, r + kV, as->dx[k], Bs);
-        affine_.add_moment(st, k, p, r + kW, as->dx[k], Bw);
+        affine_.add_moment(st, k, p, r + kV, *as, Bs);
+        affine_.add_moment(st, k, p, r + kW, *as, Bw);
       }
     }
     if (as) {
@@ -604,7 +604,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
-    sim.shape->evaluate(sim.grid, P, b, count, st);
+    affine_.evaluate(sim, P, b, count, st, affine_on_ && !REMAPPED);
     const int npp = NPP ? NPP : st.npp;
     const double* g = node_.data();
     double* L = sc.L.data();

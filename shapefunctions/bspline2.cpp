@@ -107,6 +107,7 @@ class BSpline2 : public ShapeFunction<D> {
         node[d][1][p] = b * stride;
         node[d][2][p] = (b < n ? b + 1 : n) * stride;
       }
+      ax.offsets(g, d, x, count, out);
     }
     ax.tensor_product(count, out);
   }

@@ -304,6 +304,7 @@ class Gimp : public ShapeFunction<D> {
           ax.node[d][j][p] = (i < 0 ? 0 : (i > n ? n : i)) * stride;
         }
       }
+      ax.offsets(g, d, x, count, out);
     }
     ax.tensor_product(count, out);
   }

@@ -25,7 +25,9 @@ class Linear : public ShapeFunction<D> {
     // Per-axis weights first (vectorises across particles), then the 2^D tensor products,
     // node-major so that each inner loop runs over contiguous particles.
     alignas(64) double n0[D][kBlock], n1[D][kBlock];
+    alignas(64) double x0[D][kBlock], x1[D][kBlock];  // x_I - x_p of the cell's two nodes
     alignas(64) int32_t base[kBlock];
+    const bool affine = out.affine != StencilBlock<D>::kNone;
     for (int p = 0; p < count; ++p) base[p] = 0;
     for (int d = 0; d < D; ++d) {
       const double* x = P.col(P.position, d) + begin;
@@ -40,8 +42,14 @@ class Linear : public ShapeFunction<D> {
         n0[d][p] = 1.0 - r;
         n1[d][p] = r;
         base[p] += c * stride;
+        if (affine) {  // the offsets, node coordinates as Grid::node_coord forms them
+          x0[d][p] = (o + double(c) * g.cell[size_t(d)]) - x[p];
+          x1[d][p] = (o + double(c + 1) * g.cell[size_t(d)]) - x[p];
+        }
       }
     }
+    out.has_affine = affine;
+    if (affine) offsets_and_inertia(count, n0, n1, x0, x1, out);
     for (int k = 0; k < K; ++k) {
       int32_t offset = 0;
       for (int d = 0; d < D; ++d) offset += (k >> d) & 1 ? int32_t(g.node_stride[d]) : 0;
@@ -65,6 +73,26 @@ class Linear : public ShapeFunction<D> {
         }
       }
     }
+  }
+
+ private:
+  /// The affine transfers' geometry (StencilBlock::affine): x_I - x_p of every entry and, with
+  /// kInertia, D_p^-1 = diag(1 / (n0 dx0^2 + n1 dx1^2)) per axis (tensor-product weights with
+  /// partition of unity and linear reproduction, as in framework/axis_stencil.hpp).
+  static void offsets_and_inertia(int count, const double (&n0)[D][kBlock],
+                                  const double (&n1)[D][kBlock], const double (&x0)[D][kBlock],
+                                  const double (&x1)[D][kBlock], StencilBlock<D>& out) {
+    for (int k = 0; k < (1 << D); ++k)
+      for (int d = 0; d < D; ++d) {
+        const double* a = (k >> d) & 1 ? x1[d] : x0[d];
+        double* __restrict o = out.dx.data() + (size_t(k) * D + size_t(d)) * kBlock;
+        for (int p = 0; p < count; ++p) o[p] = a[p];
+      }
+    if (out.affine != StencilBlock<D>::kInertia) return;
+    for (int d = 0; d < D; ++d)
+      for (int p = 0; p < count; ++p)
+        out.inertia_inv[size_t(d) * kBlock + size_t(p)] =
+            1.0 / (n0[d][p] * x0[d][p] * x0[d][p] + n1[d][p] * x1[d][p] * x1[d][p]);
   }
 };
 

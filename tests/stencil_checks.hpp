@@ -75,6 +75,63 @@ StencilErrors stencil_consistency(loam::Simulation<D>& sim) {
   return e;
 }
 
+/// The affine transfers' geometry a tensor-product shape function gives from its axis values
+/// (StencilBlock::affine, framework/axis_stencil.hpp) against the same from the node coordinates:
+/// offsets x_I - x_p that differ from Grid::node_coord - x_p in any bit, max |D_dd / D^-1 - 1| and
+/// max |D_de| / (h_d h_e) (d != e) of D_p = sum_k N_k dx_k dx_k^T, stencil entries whose node,
+/// weight or gradient differ from the plain evaluation, and whether the shape function filled
+/// them at all.
+struct AffineGeometryErrors {
+  double offsets = 0, inertia = 0, off_diagonal = 0, changed = 0;
+  bool filled = true;
+};
+
+template <int D>
+AffineGeometryErrors affine_geometry_errors(loam::Simulation<D>& sim) {
+  auto& P = sim.sets[0].particles;
+  const auto& g = sim.grid;
+  loam::StencilBlock<D> plain, st;
+  plain.allocate(sim.shape->nodes_per_particle());
+  st.allocate(sim.shape->nodes_per_particle());
+  AffineGeometryErrors e;
+  for (size_t b = 0; b < P.size(); b += loam::kBlock) {
+    const int count = int(std::min<size_t>(loam::kBlock, P.size() - b));
+    sim.shape->evaluate(g, P, b, count, plain);
+    st.affine = loam::StencilBlock<D>::kInertia;
+    sim.shape->evaluate(g, P, b, count, st);
+    e.filled = e.filled && st.has_affine;
+    if (!st.has_affine) continue;
+    for (int p = 0; p < count; ++p) {
+      double Dp[D][D] = {};
+      for (int k = 0; k < st.npp; ++k) {
+        const size_t kp = size_t(k) * loam::kBlock + size_t(p);
+        bool same = st.node[kp] == plain.node[kp] && st.w[kp] == plain.w[kp];
+        double dx[D];
+        for (int d = 0; d < D; ++d) {
+          const size_t kdp = (size_t(k) * D + size_t(d)) * loam::kBlock + size_t(p);
+          same = same && st.grad[kdp] == plain.grad[kdp];
+          dx[d] = g.node_coord(size_t(st.node[kp]), d) - P.col(P.position, d)[b + size_t(p)];
+          if (st.dx[kdp] != dx[d]) e.offsets += 1;
+        }
+        if (!same) e.changed += 1;
+        for (int d = 0; d < D; ++d)
+          for (int j = 0; j < D; ++j) Dp[d][j] += st.w[kp] * dx[d] * dx[j];
+      }
+      for (int d = 0; d < D; ++d)
+        for (int j = 0; j < D; ++j) {
+          if (d == j)
+            e.inertia = std::max(
+                e.inertia,
+                std::fabs(Dp[d][d] * st.inertia_inv[size_t(d) * loam::kBlock + size_t(p)] - 1));
+          else
+            e.off_diagonal = std::max(
+                e.off_diagonal, std::fabs(Dp[d][j]) / (g.cell[size_t(d)] * g.cell[size_t(j)]));
+        }
+    }
+  }
+  return e;
+}
+
 /// Weight and gradient per node of one particle, summed over stencil entries (entries for nodes
 /// outside the grid map to a valid node with zero weight, and CPDI repeats nodes, so summing is
 /// exact).

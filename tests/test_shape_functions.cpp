@@ -167,6 +167,65 @@ TEST_CASE("gimp, bspline2: partition of unity, zero gradient sum, linear reprodu
   check_random_consistency<2>("linear", 0.0, 1.0, "linear");
 }
 
+TEST_CASE(
+    "linear, gimp, bspline2: the affine offsets and diagonal D_p from the axis values equal "
+    "those from the node coordinates (1D-3D, at the grid boundary, stretched GIMP)",
+    "[shape][unit][apic]") {
+  // framework/axis_stencil.hpp, shapefunctions/linear.cpp: for APIC and TPIC a tensor-product
+  // shape function gives
+  // x_I - x_p and D_p^-1 = diag(1 / sum_j w_j dx_j^2) from its axis values. Reference: the node
+  // coordinates (Grid::node_coord), D_p = sum_k N_k dx_k dx_k^T (docs/transfers.md). Expected:
+  // the offsets bit for bit; D_p diagonal to round-off (partition of unity and linear
+  // reproduction, boundary-modified nodes included): |D_dd D^-1 - 1| and |D_de| / h^2 below
+  // 1e-12; nodes, weights and gradients unchanged by the request. Positions: random over the
+  // whole grid for B-splines (the boundary-modified nodes included), inside it for GIMP, then
+  // every particle on the grid's lower and upper faces; GIMP stretched (4 nodes per axis).
+  auto check = [](auto dim, const std::string& shape, double lo, double hi, bool stretch) {
+    constexpr int D = decltype(dim)::value;
+    auto sim = make_simulation<D>(scene<D>(shape));
+    auto& P = sim->sets[0].particles;
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> u(lo, hi), f(0.3, 4.0);
+    const int F = P.find("deformation_gradient");
+    loam_test::AffineGeometryErrors worst;
+    for (int round = 0; round < 8; ++round) {
+      for (size_t i = 0; i < P.size(); ++i)
+        for (int d = 0; d < D; ++d) {
+          // rounds 6 and 7: every particle on the lower, then the upper faces of the grid
+          P.col(P.position, d)[i] = round < 6 ? u(rng) : (round == 6 ? lo : hi);
+          if (stretch) P.col(F, d * D + d)[i] = f(rng);
+        }
+      if (stretch) sim->shape->begin_step(*sim);
+      REQUIRE(sim->failure.empty());
+      const auto e = loam_test::affine_geometry_errors(*sim);
+      REQUIRE(e.filled);
+      worst.offsets += e.offsets, worst.changed += e.changed;
+      worst.inertia = std::max(worst.inertia, e.inertia);
+      worst.off_diagonal = std::max(worst.off_diagonal, e.off_diagonal);
+    }
+    std::printf(
+        "%-28s %dD: offsets differing %g, max |D_dd D^-1 - 1| %.2e, max |D_de|/h^2 %.2e, "
+        "entries changed %g\n",
+        shape.c_str(), D, worst.offsets, worst.inertia, worst.off_diagonal, worst.changed);
+    CHECK(worst.offsets == 0);
+    CHECK(worst.inertia < 1e-12);
+    CHECK(worst.off_diagonal < 1e-12);
+    CHECK(worst.changed == 0);
+  };
+  auto all = [&](auto dim) {
+    check(dim, "linear", 0.0, 1.0, false);
+    check(dim, "bspline2", 0.0, 1.0, false);
+    check(dim, "gimp", 0.025, 0.975, false);
+    check(dim, "{type: gimp, domain_update: stretch}", 0.1, 0.9, true);
+  };
+  all(std::integral_constant<int, 1>{});
+  all(std::integral_constant<int, 2>{});
+  all(std::integral_constant<int, 3>{});
+  // CPDI's weights are not axis products: it leaves it to AffineTransfer (node coordinates).
+  auto cpdi = make_simulation<2>(scene<2>("cpdi"));
+  CHECK_FALSE(loam_test::affine_geometry_errors(*cpdi).filled);
+}
+
 TEST_CASE("gimp with stretched domains (lp up to one cell): consistency in 1D-3D",
           "[shape][unit]") {
   auto run = [](auto dim) {
