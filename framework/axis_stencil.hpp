@@ -7,6 +7,38 @@
 
 namespace loam {
 
+/// The affine transfers' geometry (StencilBlock::affine) of a tensor-product stencil from its
+/// axis weights w and offsets dx (entry k is node (k / M^d) % M along axis d), for a block
+/// whose pass asked for it; sets out.has_affine. The offsets of every entry and, with
+/// kInertia, D_p^-1. For weights that are products of axis weights, D_p = sum_k N_k dx_k dx_k^T
+/// factors into axis moments m_n(d) = sum_j w_dj dx_dj^n: D_dd = m_2(d) prod_(e != d) m_0(e)
+/// and D_de = m_1(d) m_1(e) prod_(f != d, e) m_0(f). Partition of unity (m_0 = 1) and linear
+/// reproduction (m_1 = 0) hold for the weights that use this (linear, gimp and bspline2, their
+/// boundary-modified nodes included), so D_p = diag(m_2(d)) up to round-off (h^2/4 per axis for
+/// interior quadratic B-splines, as Jiang et al. 2015 give).
+template <int D, int M>
+void axis_affine_product(int count, const double (&w)[D][M][kBlock],
+                         const double (&dx)[D][M][kBlock], StencilBlock<D>& out) {
+  out.has_affine = out.affine != StencilBlock<D>::kNone;
+  if (!out.has_affine) return;
+  constexpr int K = ipow(M, D);
+  for (int k = 0; k < K; ++k)
+    for (int d = 0, r = k; d < D; ++d, r /= M) {
+      const double* a = dx[d][r % M];
+      double* __restrict o = out.dx.data() + (size_t(k) * D + size_t(d)) * kBlock;
+      for (int p = 0; p < count; ++p) o[p] = a[p];
+    }
+  if (out.affine != StencilBlock<D>::kInertia) return;
+  for (int d = 0; d < D; ++d) {
+    double* __restrict inv = out.inertia_inv.data() + size_t(d) * kBlock;
+    for (int p = 0; p < count; ++p) {
+      double m2 = 0;
+      for (int j = 0; j < M; ++j) m2 += w[d][j][p] * dx[d][j][p] * dx[d][j][p];
+      inv[p] = 1.0 / m2;
+    }
+  }
+}
+
 /// Per-axis weights, gradients and node offsets (node coordinate times stride) of M nodes for a
 /// block of particles, and their tensor product into the stencil, node-major.
 template <int D, int M>
@@ -30,8 +62,7 @@ struct AxisStencil {
 
   void tensor_product(int count, StencilBlock<D>& out) const {
     constexpr int K = ipow(M, D);
-    out.has_affine = out.affine != StencilBlock<D>::kNone;
-    if (out.has_affine) affine_product(count, out);
+    axis_affine_product<D, M>(count, w, dx, out);
     for (int k = 0; k < K; ++k) {
       // Entry k is node j[0] along x, j[1] along y, ...: N = prod_d w_d, dN/dx_d = dw_d prod_e!=d
       // w_e. One fused loop per entry (node, weight and gradients); the outputs are restrict:
@@ -62,33 +93,6 @@ struct AxisStencil {
             if (e != d) gp *= wa[e][p];
           grad_k[size_t(d) * kBlock + size_t(p)] = gp;
         }
-      }
-    }
-  }
-
- private:
-  /// The affine transfers' offsets of every entry and, with kInertia, D_p^-1. For weights that
-  /// are products of axis weights, D_p = sum_k N_k dx_k dx_k^T factors into axis moments
-  /// m_n(d) = sum_j w_dj dx_dj^n: D_dd = m_2(d) prod_(e != d) m_0(e) and D_de = m_1(d) m_1(e)
-  /// prod_(f != d, e) m_0(f). Partition of unity (m_0 = 1) and linear reproduction (m_1 = 0)
-  /// hold for the weights that use this (gimp and bspline2, their boundary-modified nodes
-  /// included), so D_p = diag(m_2(d)) up to round-off (h^2/4 per axis for interior quadratic
-  /// B-splines, as Jiang et al. 2015 give).
-  void affine_product(int count, StencilBlock<D>& out) const {
-    constexpr int K = ipow(M, D);
-    for (int k = 0; k < K; ++k)
-      for (int d = 0, r = k; d < D; ++d, r /= M) {
-        const double* a = dx[d][r % M];
-        double* __restrict o = out.dx.data() + (size_t(k) * D + size_t(d)) * kBlock;
-        for (int p = 0; p < count; ++p) o[p] = a[p];
-      }
-    if (out.affine != StencilBlock<D>::kInertia) return;
-    for (int d = 0; d < D; ++d) {
-      double* __restrict inv = out.inertia_inv.data() + size_t(d) * kBlock;
-      for (int p = 0; p < count; ++p) {
-        double m2 = 0;
-        for (int j = 0; j < M; ++j) m2 += w[d][j][p] * dx[d][j][p] * dx[d][j][p];
-        inv[p] = 1.0 / m2;
       }
     }
   }

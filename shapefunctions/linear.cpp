@@ -1,5 +1,6 @@
 // Linear (tent) shape functions on the cell containing the particle: 2^D nodes, C0 across cell
 // faces (the source of cell-crossing noise that GIMP, CPDI and B-splines remove).
+#include "framework/axis_stencil.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 
@@ -24,8 +25,8 @@ class Linear : public ShapeFunction<D> {
     out.count = count;
     // Per-axis weights first (vectorises across particles), then the 2^D tensor products,
     // node-major so that each inner loop runs over contiguous particles.
-    alignas(64) double n0[D][kBlock], n1[D][kBlock];
-    alignas(64) double x0[D][kBlock], x1[D][kBlock];  // x_I - x_p of the cell's two nodes
+    alignas(64) double n[D][2][kBlock];   // the two nodes' axis weights
+    alignas(64) double dx[D][2][kBlock];  // their x_I - x_p, for the affine transfers
     alignas(64) int32_t base[kBlock];
     const bool affine = out.affine != StencilBlock<D>::kNone;
     for (int p = 0; p < count; ++p) base[p] = 0;
@@ -39,17 +40,16 @@ class Linear : public ShapeFunction<D> {
         int c = int(xi);
         c = c < 0 ? 0 : (c > last ? last : c);  // stay inside the grid
         const double r = xi - c;
-        n0[d][p] = 1.0 - r;
-        n1[d][p] = r;
+        n[d][0][p] = 1.0 - r;
+        n[d][1][p] = r;
         base[p] += c * stride;
         if (affine) {  // the offsets, node coordinates as Grid::node_coord forms them
-          x0[d][p] = (o + double(c) * g.cell[size_t(d)]) - x[p];
-          x1[d][p] = (o + double(c + 1) * g.cell[size_t(d)]) - x[p];
+          dx[d][0][p] = (o + double(c) * g.cell[size_t(d)]) - x[p];
+          dx[d][1][p] = (o + double(c + 1) * g.cell[size_t(d)]) - x[p];
         }
       }
     }
-    out.has_affine = affine;
-    if (affine) offsets_and_inertia(count, n0, n1, x0, x1, out);
+    axis_affine_product<D, 2>(count, n, dx, out);
     for (int k = 0; k < K; ++k) {
       int32_t offset = 0;
       for (int d = 0; d < D; ++d) offset += (k >> d) & 1 ? int32_t(g.node_stride[d]) : 0;
@@ -58,7 +58,7 @@ class Linear : public ShapeFunction<D> {
       for (int p = 0; p < count; ++p) {
         node[p] = base[p] + offset;
         double wp = 1.0;
-        for (int d = 0; d < D; ++d) wp *= (k >> d) & 1 ? n1[d][p] : n0[d][p];
+        for (int d = 0; d < D; ++d) wp *= n[d][(k >> d) & 1][p];
         w[p] = wp;
       }
       for (int d = 0; d < D; ++d) {
@@ -68,31 +68,11 @@ class Linear : public ShapeFunction<D> {
         for (int p = 0; p < count; ++p) {
           double gp = sign_ih;
           for (int e = 0; e < D; ++e)
-            if (e != d) gp *= (k >> e) & 1 ? n1[e][p] : n0[e][p];
+            if (e != d) gp *= n[e][(k >> e) & 1][p];
           gr[p] = gp;
         }
       }
     }
-  }
-
- private:
-  /// The affine transfers' geometry (StencilBlock::affine): x_I - x_p of every entry and, with
-  /// kInertia, D_p^-1 = diag(1 / (n0 dx0^2 + n1 dx1^2)) per axis (tensor-product weights with
-  /// partition of unity and linear reproduction, as in framework/axis_stencil.hpp).
-  static void offsets_and_inertia(int count, const double (&n0)[D][kBlock],
-                                  const double (&n1)[D][kBlock], const double (&x0)[D][kBlock],
-                                  const double (&x1)[D][kBlock], StencilBlock<D>& out) {
-    for (int k = 0; k < (1 << D); ++k)
-      for (int d = 0; d < D; ++d) {
-        const double* a = (k >> d) & 1 ? x1[d] : x0[d];
-        double* __restrict o = out.dx.data() + (size_t(k) * D + size_t(d)) * kBlock;
-        for (int p = 0; p < count; ++p) o[p] = a[p];
-      }
-    if (out.affine != StencilBlock<D>::kInertia) return;
-    for (int d = 0; d < D; ++d)
-      for (int p = 0; p < count; ++p)
-        out.inertia_inv[size_t(d) * kBlock + size_t(p)] =
-            1.0 / (n0[d][p] * x0[d][p] * x0[d][p] + n1[d][p] * x1[d][p] * x1[d][p]);
   }
 };
 
