@@ -11,7 +11,8 @@
 
 namespace loam {
 
-CheckpointWriter::CheckpointWriter(const std::string& file) : file_(file), tmp_(file + ".tmp") {
+CheckpointWriter::CheckpointWriter(const std::string& file)
+    : file_(file), tmp_(file + ".tmp"), guard_(tmp_) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   errno = 0;
   const hid_t f = H5Fcreate(tmp_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);

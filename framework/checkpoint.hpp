@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "interrupt.hpp"
+
 namespace loam {
 
 /// Writes arrays into a new checkpoint; close() makes it durable and gives it its name.
@@ -31,6 +33,7 @@ class CheckpointWriter {
 
  private:
   std::string file_, tmp_;
+  TemporaryFileGuard guard_;  // a second signal removes the .tmp
   long long handle_ = -1;
   bool ok_ = true;
   void raw(const std::string& name, const void* data, size_t n, long long type);

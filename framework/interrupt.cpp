@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <csignal>
 #include <cstring>
 #include <mutex>
@@ -58,12 +59,16 @@ int InterruptGuard::requested() {
   return g_signal;
 }
 
+// A slot is live while its first byte is set: the rest of the path is written first and the
+// first byte last (and cleared first), so the handler never reads a half-written path.
 void register_temporary_file(const std::string& path) {
-  if (path.size() >= kPath) return;
+  if (path.empty() || path.size() >= kPath) return;
   std::lock_guard<std::mutex> lock(g_temporary_mutex);
   for (auto& slot : g_temporary)
     if (!slot[0]) {
-      std::memcpy(slot, path.c_str(), path.size() + 1);
+      std::memcpy(slot + 1, path.c_str() + 1, path.size());
+      std::atomic_signal_fence(std::memory_order_seq_cst);
+      slot[0] = path[0];
       return;
     }
 }
@@ -71,7 +76,11 @@ void register_temporary_file(const std::string& path) {
 void unregister_temporary_file(const std::string& path) {
   std::lock_guard<std::mutex> lock(g_temporary_mutex);
   for (auto& slot : g_temporary)
-    if (slot[0] && path == slot) slot[0] = '\0';
+    if (slot[0] && path == slot) {
+      slot[0] = '\0';
+      std::atomic_signal_fence(std::memory_order_seq_cst);
+      return;
+    }
 }
 
 std::string signal_name(int signal) {

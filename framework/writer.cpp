@@ -3,10 +3,13 @@
 #include <filesystem>
 #include <fstream>
 
+#include "interrupt.hpp"
+
 namespace loam {
 
 void write_file_atomically(const std::string& file, const std::string& text) {
   const std::string tmp = file + ".tmp";
+  const TemporaryFileGuard guard(tmp);  // a second signal removes it
   errno = 0;
   bool written;
   {

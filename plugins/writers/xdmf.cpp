@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "framework/interrupt.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 
@@ -110,6 +111,7 @@ class Xdmf : public Writer<D> {
     std::filesystem::path file = std::filesystem::path(dir_) / name;
     std::filesystem::path tmp = file;
     tmp += ".tmp";
+    const TemporaryFileGuard guard(tmp.string());  // a second signal removes it
     errno = 0;
     hid_t f = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     if (f < 0) fail(file, tmp);
