@@ -9,6 +9,7 @@
 #include "config.hpp"
 #include "docs.hpp"
 #include "element_test.hpp"
+#include "launch.hpp"
 #include "runner.hpp"
 
 int main(int argc, char** argv) {
@@ -103,6 +104,16 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   spdlog::set_pattern("[%H:%M:%S] %^%l%$ %v");
+
+  // Under mpirun -np N > 1: refuse the commands that compute, before they write anything.
+  for (auto* cmd : {run, element, bench, compare})
+    if (*cmd) {
+      const std::string refusal = loam::refuse_mpi_launch(cmd->get_name());
+      if (!refusal.empty()) {
+        fputs(refusal.c_str(), stderr);
+        return 2;
+      }
+    }
 
   if (*run) {
     if (run_opt.quiet) spdlog::set_level(spdlog::level::warn);

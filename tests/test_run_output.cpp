@@ -236,3 +236,35 @@ TEST_CASE("a file that cannot be written stops the run with exit 4, naming it, t
   CHECK(!loam_test::has_tmp_files(dir.path));
   std::filesystem::remove(dir.path.string() + ".err");
 }
+
+TEST_CASE(
+    "started as one of several MPI ranks, loam run, compare and bench refuse, writing nothing",
+    "[output][mpi]") {
+  // framework/launch.hpp: the launcher's environment (OpenMPI's OMPI_COMM_WORLD_SIZE, Hydra's
+  // PMI_SIZE) gives the rank count; with more than one rank every copy would run the scene into
+  // the same directory (the MPI tier runs the same under a real mpirun -np 2). One rank is fine.
+  const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/vibrating_bar.yaml";
+  for (const std::string env : {"OMPI_COMM_WORLD_SIZE=2", "PMI_SIZE=4"}) {
+    TempDir dir("mpi_refused");
+    std::filesystem::remove_all(dir.path);
+    const std::string err = dir.path.string() + ".err";
+    const int code =
+        loam_test::run_bash(env + " " + LOAM_EXE + " run " + cfg + " --quiet --threads 1 --out " +
+                            dir.path.string() + " 2>" + err);
+    const std::string text = slurp(err);
+    std::printf("%s loam run: exit %d: %s", env.c_str(), code, text.c_str());
+    CHECK(code == 2);
+    CHECK(text.find("error: loam run was started as one of ") == 0);
+    CHECK(text.find("docs/parallel.md") != std::string::npos);
+    CHECK(!std::filesystem::exists(dir.path));
+    CHECK(loam_test::run_bash(env + " " + LOAM_EXE + " bench --steps 1 2>/dev/null") == 2);
+    CHECK(loam_test::run_bash(env + " " + LOAM_EXE + " compare " + cfg + " 2>/dev/null") == 2);
+    std::filesystem::remove(err);
+  }
+  // One rank (mpirun -np 1) runs as usual.
+  TempDir one("mpi_one_rank");
+  CHECK(loam_test::run_bash("OMPI_COMM_WORLD_SIZE=1 " + std::string(LOAM_EXE) + " run " + cfg +
+                            " --quiet --threads 1 --set time.end=0.2 --overwrite --out " +
+                            one.path.string()) == 0);
+  CHECK(std::filesystem::exists(one.path / "summary.json"));
+}
