@@ -54,10 +54,12 @@ struct AxisStencil {
   void offsets(const Grid<D>& g, int d, const double* x, int count, const StencilBlock<D>& out) {
     if (out.affine == StencilBlock<D>::kNone) return;
     const double o = g.origin[size_t(d)], h = g.cell[size_t(d)];
-    // node = i * stride exactly, so the double quotient is i exactly (and vectorises)
-    const double stride = double(g.node_stride[d]);
+    // node = (i - lo) * stride exactly, so the double quotient is i - lo exactly (and
+    // vectorises); lo: the stored box's first node (Grid; 0 serially, adding it is exact)
+    const double stride = double(g.node_stride[d]), lo = double(g.node_lo[size_t(d)]);
     for (int j = 0; j < M; ++j)
-      for (int p = 0; p < count; ++p) dx[d][j][p] = (o + double(node[d][j][p]) / stride * h) - x[p];
+      for (int p = 0; p < count; ++p)
+        dx[d][j][p] = (o + (double(node[d][j][p]) / stride + lo) * h) - x[p];
   }
 
   void tensor_product(int count, StencilBlock<D>& out) const {

@@ -2,6 +2,12 @@
 // Uniform Cartesian background grid, templated on dimension. Node (i, j, k) has linear index
 // i + nx*(j + ny*k); the last axis varies slowest, so slabs of cell rows along it are contiguous
 // in memory and in the cell-sorted particle order.
+//
+// The nodes a process stores are a box of the grid, [node_lo, node_lo + box_nodes) per axis:
+// the whole grid serially, a rank's owned nodes and ghost layer under MPI (docs/parallel.md,
+// framework/decomposition.hpp). num_nodes, node_stride and the node index n count the box;
+// node_ijk(n) and node_coord are global; nodes and cells are the whole grid's, so a face of the
+// grid is where node_ijk reaches 0 or nodes - 1.
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -12,6 +18,7 @@ template <int D>
 struct Grid {
   std::array<double, D> origin{}, cell{}, inv_cell{};
   std::array<int, D> cells{}, nodes{};
+  std::array<int, D> node_lo{}, box_nodes{};  // the stored box of nodes (the header)
   std::array<long, D> node_stride{}, cell_stride{};
   size_t num_nodes = 0, num_cells = 0;
 
@@ -24,11 +31,34 @@ struct Grid {
       cell[d] = extent[d] / cells[d];  // exact fit of the extent
       inv_cell[d] = 1.0 / cell[d];
       nodes[d] = cells[d] + 1;
-      node_stride[d] = long(num_nodes);
       cell_stride[d] = long(num_cells);
-      num_nodes *= size_t(nodes[d]);
       num_cells *= size_t(cells[d]);
     }
+    std::array<int, D> lo{};
+    store_nodes(lo, nodes);
+  }
+
+  /// Store only the nodes [lo, hi) per axis (global indices): node indices then count that box.
+  void store_nodes(const std::array<int, D>& lo, const std::array<int, D>& hi) {
+    num_nodes = 1;
+    for (int d = 0; d < D; ++d) {
+      node_lo[d] = lo[d];
+      box_nodes[d] = hi[d] - lo[d];
+      node_stride[d] = long(num_nodes);
+      num_nodes *= size_t(box_nodes[d]);
+    }
+  }
+  /// Index of the stored node with global indices ijk (inside the box).
+  size_t node_index(const std::array<int, D>& ijk) const {
+    size_t n = 0;
+    for (int d = 0; d < D; ++d) n += size_t(ijk[d] - node_lo[d]) * size_t(node_stride[d]);
+    return n;
+  }
+  /// Whether the node with global indices ijk is stored.
+  bool stores_node(const std::array<int, D>& ijk) const {
+    for (int d = 0; d < D; ++d)
+      if (ijk[d] < node_lo[d] || ijk[d] >= node_lo[d] + box_nodes[d]) return false;
+    return true;
   }
 
   double min_cell() const {
@@ -38,11 +68,12 @@ struct Grid {
   }
   double upper(int d) const { return origin[d] + cells[d] * cell[d]; }
 
+  /// Global indices of stored node n.
   std::array<int, D> node_ijk(size_t n) const {
     std::array<int, D> ijk{};
     for (int d = 0; d < D; ++d) {
-      ijk[d] = int(n % size_t(nodes[d]));
-      n /= size_t(nodes[d]);
+      ijk[d] = int(n % size_t(box_nodes[d])) + node_lo[d];
+      n /= size_t(box_nodes[d]);
     }
     return ijk;
   }

@@ -105,7 +105,8 @@ void Run<D>::check_outputs(Diagnostics& diag) {
                          " is not an integer in [0, " + std::to_string(sim_->grid.nodes[d] - 1) +
                          "]");
         }
-        idx += size_t(std::max(0L, k)) * size_t(sim_->grid.node_stride[d]);
+        idx += size_t(std::max(0L, k - sim_->grid.node_lo[size_t(d)])) *
+               size_t(sim_->grid.node_stride[d]);
       }
       probe.node = idx;
     } else {

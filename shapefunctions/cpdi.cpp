@@ -204,7 +204,7 @@ class Cpdi : public ShapeFunction<D> {
     alignas(64) int32_t node[D][3][kBlock];
     for (int d = 0; d < D; ++d) {
       const int n = g.cells[d];
-      const int32_t stride = int32_t(g.node_stride[d]);
+      const int32_t stride = int32_t(g.node_stride[d]), lo = g.node_lo[size_t(d)];
       alignas(64) int32_t base[kBlock];
       for (int p = 0; p < count; ++p) {
         int b = cs.cell[0][d][p];
@@ -222,7 +222,7 @@ class Cpdi : public ShapeFunction<D> {
       for (int j = 0; j < 3; ++j)
         for (int p = 0; p < count; ++p) {
           const int i = base[p] + j;  // node n + 1 (all corners in the last cell) has weight 0
-          node[d][j][p] = (i > n ? n : i) * stride;
+          node[d][j][p] = ((i > n ? n : i) - lo) * stride;  // the stored box's index (Grid)
         }
     }
     for (int k = 0; k < K; ++k) {
@@ -260,8 +260,8 @@ class Cpdi : public ShapeFunction<D> {
       alignas(64) int32_t base[kBlock];
       for (int p = 0; p < count; ++p) base[p] = 0;
       for (int d = 0; d < D; ++d) {
-        const int32_t stride = int32_t(g.node_stride[d]);
-        for (int p = 0; p < count; ++p) base[p] += cs.cell[alpha][d][p] * stride;
+        const int32_t stride = int32_t(g.node_stride[d]), lo = g.node_lo[size_t(d)];
+        for (int p = 0; p < count; ++p) base[p] += (cs.cell[alpha][d][p] - lo) * stride;
       }
       for (int m = 0; m < C; ++m) {
         const int k = alpha * C + m;

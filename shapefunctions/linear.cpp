@@ -34,7 +34,7 @@ class Linear : public ShapeFunction<D> {
       const double* x = P.col(P.position, d) + begin;
       const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
       const int last = g.cells[d] - 1;
-      const int32_t stride = int32_t(g.node_stride[d]);
+      const int32_t stride = int32_t(g.node_stride[d]), lo = g.node_lo[size_t(d)];
       for (int p = 0; p < count; ++p) {
         const double xi = (x[p] - o) * ih;
         int c = int(xi);
@@ -42,7 +42,7 @@ class Linear : public ShapeFunction<D> {
         const double r = xi - c;
         n[d][0][p] = 1.0 - r;
         n[d][1][p] = r;
-        base[p] += c * stride;
+        base[p] += (c - lo) * stride;  // the stored box's index (Grid)
         if (affine) {  // the offsets, node coordinates as Grid::node_coord forms them
           dx[d][0][p] = (o + double(c) * g.cell[size_t(d)]) - x[p];
           dx[d][1][p] = (o + double(c + 1) * g.cell[size_t(d)]) - x[p];

@@ -3,8 +3,10 @@
 // owned nodes of the blocks partition the grid's nodes, every stencil entry of the particles in
 // a block's cells lands in its box (owned nodes + ghost layer), and what a block sends to a
 // neighbour is, node for node and in order, what the neighbour expects; a block narrower than
-// its ghost layer is refused with the reason. The exchange itself runs under mpirun
-// (tests/mpi/test_halo_exchange.cpp).
+// its ghost layer is refused with the reason; and every shape function evaluated on a grid that
+// stores only a block's box of nodes (Grid::store_nodes) gives the whole grid's weights,
+// gradients and affine geometry, bit for bit, on the same nodes. The exchange itself runs under
+// mpirun (tests/mpi/test_halo_exchange.cpp).
 #include <catch2/catch.hpp>
 #include <map>
 
@@ -121,4 +123,78 @@ TEST_CASE("decomposition: a block narrower than the ghost layer is refused with 
   }
   // Linear tents reach one row: one cell per block is enough.
   CHECK_NOTHROW(Decomposition<1>(g, {23}, {22}, 0, 1));
+}
+
+namespace {
+
+/// Blocks of `dims`: each block's particles evaluated on the whole grid and on a grid storing
+/// only the block's box; counts entries that differ (weights, gradients, offsets and D_p^-1 bit
+/// for bit; the node by its global indices) and local indices outside the box.
+template <int D>
+void check_box_evaluation(const std::string& shape, const std::array<int, D>& dims) {
+  auto sim = loam_test::decomposition_scene<D>(shape);
+  const auto& g = sim->grid;
+  const auto& P = sim->sets[0].particles;
+  sim->shape->begin_step(*sim);
+  long differing = 0, outside = 0, entries = 0, boxes_not_whole = 0;
+  for (const auto& c : every_block<D>(dims)) {
+    const Decomposition<D> dec(g, dims, c, sim->shape->rows_below(), sim->shape->rows_above());
+    loam::Grid<D> local = g;
+    local.store_nodes(dec.box().lo, dec.box().hi);
+    boxes_not_whole += local.num_nodes < g.num_nodes;
+    loam::StencilBlock<D> whole, box;
+    whole.allocate(sim->shape->max_nodes_per_particle());
+    box.allocate(sim->shape->max_nodes_per_particle());
+    for (size_t b = 0; b < P.size(); b += loam::kBlock) {
+      const int count = int(std::min<size_t>(loam::kBlock, P.size() - b));
+      whole.affine = box.affine = loam::StencilBlock<D>::kInertia;
+      sim->shape->evaluate(g, P, b, count, whole);
+      sim->shape->evaluate(local, P, b, count, box);
+      for (int p = 0; p < count; ++p) {
+        std::array<int, D> cell{};
+        for (int d = 0; d < D; ++d)
+          cell[size_t(d)] = g.cell_of(P.col(P.position, d)[b + size_t(p)], d);
+        if (!dec.owns_cell(cell)) continue;
+        for (int k = 0; k < sim->shape->nodes_per_particle(); ++k) {  // CPDI: this step's
+          const size_t kp = size_t(k) * loam::kBlock + size_t(p);
+          ++entries;
+          if (box.node[kp] < 0 || size_t(box.node[kp]) >= local.num_nodes) {
+            ++outside;
+            continue;
+          }
+          bool same = whole.w[kp] == box.w[kp] &&
+                      local.node_ijk(size_t(box.node[kp])) == g.node_ijk(size_t(whole.node[kp]));
+          for (int j = 0; j < D; ++j) {
+            const size_t kj = (size_t(k) * D + size_t(j)) * loam::kBlock + size_t(p);
+            same = same && whole.grad[kj] == box.grad[kj];
+            if (whole.has_affine) same = same && box.has_affine && whole.dx[kj] == box.dx[kj];
+          }
+          if (whole.has_affine)
+            for (int j = 0; j < D; ++j)
+              same = same && whole.inertia_inv[size_t(j) * loam::kBlock + size_t(p)] ==
+                                 box.inertia_inv[size_t(j) * loam::kBlock + size_t(p)];
+          differing += !same;
+        }
+      }
+    }
+  }
+  std::printf(
+      "%dD %-8s on block boxes: %ld stencil entries of owned particles, %ld differ from the "
+      "whole grid's, %ld outside the box (%ld of the boxes smaller than the grid)\n",
+      D, shape.c_str(), entries, differing, outside, boxes_not_whole);
+  CHECK(entries > 0);
+  CHECK(differing == 0);
+  CHECK(outside == 0);
+  CHECK(boxes_not_whole > 0);
+}
+
+}  // namespace
+
+TEST_CASE("decomposition: shape functions on a block's node box give the whole grid's stencil",
+          "[decomposition][mpi][shape]") {
+  for (const std::string shape : {"linear", "gimp", "bspline2", "cpdi"}) {
+    check_box_evaluation<1>(shape, {3});
+    check_box_evaluation<2>(shape, {3, 2});
+    check_box_evaluation<3>(shape, {2, 2, 2});
+  }
 }

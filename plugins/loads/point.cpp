@@ -40,7 +40,7 @@ class PointLoad : public Load<D> {
         int c = g.cell_of(x_[size_t(d)], d);
         double r = (x_[size_t(d)] - g.origin[size_t(d)]) * g.inv_cell[size_t(d)] - c;
         bool up = (k >> d) & 1;
-        node += size_t(c + (up ? 1 : 0)) * size_t(g.node_stride[d]);
+        node += size_t(c + (up ? 1 : 0) - g.node_lo[size_t(d)]) * size_t(g.node_stride[d]);
         w *= up ? r : 1 - r;
       }
       nodes_.push_back(node);

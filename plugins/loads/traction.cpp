@@ -135,7 +135,7 @@ class Traction : public Load<D> {
         const int c = g.cell_of(x, d);
         frac[size_t(d)] =
             std::clamp((x - g.origin[size_t(d)]) * g.inv_cell[size_t(d)] - c, 0.0, 1.0);
-        base += size_t(c) * size_t(g.node_stride[size_t(d)]);
+        base += size_t(c - g.node_lo[size_t(d)]) * size_t(g.node_stride[size_t(d)]);
       }
       for (int corner = 0; corner < (1 << D); ++corner) {
         double w = 1;
