@@ -5,7 +5,7 @@
 // largest value, after the forward exchange every ghost does too; the whole sequence repeated
 // gives the same bits; each particle is owned by exactly one rank; one message per neighbour
 // and exchange. In 1D, 2D and 3D with linear, gimp and bspline2 (the ghost layer follows the
-// reach). Rank 0 prints the measured numbers; the exit code is the number of failed checks.
+// reach). Rank 0 prints the measured numbers (tests/mpi/main.cpp runs it).
 #include <mpi.h>
 
 #include <cmath>
@@ -14,26 +14,11 @@
 
 #include "../decomposition_scene.hpp"
 #include "framework/mpi/halo_exchange.hpp"
+#include "mpi_check.hpp"
+
+namespace loam_mpi_test {
 
 namespace {
-
-int g_rank = 0, g_failures = 0;
-
-/// A check every rank makes; it fails if it fails on any rank (printed by rank 0).
-void check(bool ok, const std::string& what) {
-  int bad = ok ? 0 : 1, any = 0;
-  MPI_Allreduce(&bad, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  if (any) {
-    ++g_failures;
-    if (g_rank == 0) std::printf("FAILED: %s\n", what.c_str());
-  }
-}
-
-double global_max(double x) {
-  double m = 0;
-  MPI_Allreduce(&x, &m, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  return m;
-}
 
 /// Largest |local - serial| over the nodes `which` walks, per component, relative to the
 /// component's largest |serial| value over the grid.
@@ -64,8 +49,7 @@ double max_relative_error(const loam::Grid<D>& g, const loam::NodeBox<D>& box,
 template <int D>
 void halo_case(const std::string& shape) {
   constexpr int S = 1 + 2 * D;
-  int size = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const int size = loam_mpi_test::size(), g_rank = rank();
   auto sim = loam_test::decomposition_scene<D>(shape);
   const auto& g = sim->grid;
   std::array<int, D> dims{}, periods{}, coords{};
@@ -109,8 +93,7 @@ void halo_case(const std::string& shape) {
                          std::memcmp(runs[0].data(), runs[1].data(), runs[0].size() * 8) == 0;
 
   // Each particle owned by exactly one rank.
-  long total = 0;
-  MPI_Allreduce(&owned_particles, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  const long total = global_sum(owned_particles);
   const long n_particles = long(sim->sets[0].particles.size());
   // One message per neighbour and exchange: 4 exchanges (two runs, reverse and forward).
   const long messages = halo.messages_sent();
@@ -124,12 +107,8 @@ void halo_case(const std::string& shape) {
   extra_error = global_max(extra_error);
   box_error = global_max(box_error);
 
-  std::string name = std::to_string(D) + "D " + shape + ", " + std::to_string(size) + " ranks (";
-  for (int d = 0; d < D; ++d) {
-    if (d) name += 'x';
-    name += std::to_string(dims[size_t(d)]);
-  }
-  name += ")";
+  const std::string name = std::to_string(D) + "D " + shape + ", " + std::to_string(size) +
+                           " ranks (" + dims_name(dims) + ")";
   if (g_rank == 0)
     std::printf(
         "%-32s owned nodes after reverse: %.1e (record), %.1e (second array); every box node "
@@ -149,20 +128,12 @@ void halo_case(const std::string& shape) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  int provided = 0;
-  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
-  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
-  if (provided < MPI_THREAD_FUNNELED) {
-    if (g_rank == 0) std::printf("FAILED: MPI_THREAD_FUNNELED is not provided\n");
-    MPI_Abort(MPI_COMM_WORLD, 1);
-  }
+void halo_exchange_tests() {
   for (const std::string shape : {"linear", "gimp", "bspline2"}) {
     halo_case<1>(shape);
     halo_case<2>(shape);
     halo_case<3>(shape);
   }
-  if (g_rank == 0) std::printf("%d failed checks\n", g_failures);
-  MPI_Finalize();
-  return g_failures;
 }
+
+}  // namespace loam_mpi_test
