@@ -3,6 +3,7 @@
 // GIMP, B-splines) fill per-axis weights, gradients and node offsets for a block of particles,
 // then expand them into the StencilBlock node-major, so every inner loop runs over contiguous
 // particles and vectorises.
+#include "force_inline.hpp"
 #include "shape_function.hpp"
 
 namespace loam {
@@ -45,21 +46,24 @@ template <int D, int M>
 struct AxisStencil {
   alignas(64) double w[D][M][kBlock];
   alignas(64) double dw[D][M][kBlock];
-  alignas(64) int32_t node[D][M][kBlock];
-  alignas(64) double dx[D][M][kBlock];  // x_I - x_p along each axis, for the affine transfers
+  alignas(64) int32_t node[D][M][kBlock];   // (i - node_lo) * node_stride: the stored box's
+  alignas(64) int32_t index[D][M][kBlock];  // i: the node's global index along the axis
+  alignas(64) double dx[D][M][kBlock];      // x_I - x_p along each axis, for the affine transfers
+
+  /// Entry j of particle p along axis d is the node of global index i (clamped into the grid).
+  LOAM_FORCE_INLINE void set_node(const Grid<D>& g, int d, int j, int p, int i) {
+    index[d][j][p] = i;
+    node[d][j][p] = (i - g.node_lo[size_t(d)]) * int32_t(g.node_stride[d]);
+  }
 
   /// x_I - x_p along axis d of every entry, for the affine transfers (out.affine): the node
-  /// coordinate as Grid::node_coord forms it (origin + i h, i the clamped index of node[d]), so
-  /// the offsets are the same bits as from the node coordinates.
+  /// coordinate as Grid::node_coord forms it (origin + i h, i the global index), so the offsets
+  /// are the same bits as from the node coordinates, on a stored box of nodes too.
   void offsets(const Grid<D>& g, int d, const double* x, int count, const StencilBlock<D>& out) {
     if (out.affine == StencilBlock<D>::kNone) return;
     const double o = g.origin[size_t(d)], h = g.cell[size_t(d)];
-    // node = (i - lo) * stride exactly, so the double quotient is i - lo exactly (and
-    // vectorises); lo: the stored box's first node (Grid; 0 serially, adding it is exact)
-    const double stride = double(g.node_stride[d]), lo = double(g.node_lo[size_t(d)]);
     for (int j = 0; j < M; ++j)
-      for (int p = 0; p < count; ++p)
-        dx[d][j][p] = (o + (double(node[d][j][p]) / stride + lo) * h) - x[p];
+      for (int p = 0; p < count; ++p) dx[d][j][p] = (o + double(index[d][j][p]) * h) - x[p];
   }
 
   void tensor_product(int count, StencilBlock<D>& out) const {

@@ -70,12 +70,10 @@ class BSpline2 : public ShapeFunction<D> {
     AxisStencil<D, M> ax;
     auto& w = ax.w;
     auto& dw = ax.dw;
-    auto& node = ax.node;
     for (int d = 0; d < D; ++d) {
       const double* x = P.col(P.position, d) + begin;
       const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
       const int n = g.cells[d];  // last node index along d
-      const int32_t stride = int32_t(g.node_stride[d]), lo = g.node_lo[size_t(d)];
       const double last = double(n);
       alignas(64) double bd[kBlock];
       for (int p = 0; p < count; ++p) {
@@ -103,9 +101,9 @@ class BSpline2 : public ShapeFunction<D> {
       }
       for (int p = 0; p < count; ++p) {
         const int b = int(bd[p]);
-        node[d][0][p] = ((b > 0 ? b - 1 : 0) - lo) * stride;  // the stored box's index (Grid)
-        node[d][1][p] = (b - lo) * stride;
-        node[d][2][p] = ((b < n ? b + 1 : n) - lo) * stride;
+        ax.set_node(g, d, 0, p, b > 0 ? b - 1 : 0);
+        ax.set_node(g, d, 1, p, b);
+        ax.set_node(g, d, 2, p, b < n ? b + 1 : n);
       }
       ax.offsets(g, d, x, count, out);
     }

@@ -200,7 +200,6 @@ class Gimp : public ShapeFunction<D> {
       const double* lp = P.col(half_width_, d) + begin;
       const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
       const int n = g.cells[d];  // last node index along d
-      const int32_t stride = int32_t(g.node_stride[d]), lo = g.node_lo[size_t(d)];
       const double last = double(n);
       alignas(64) int32_t first[kBlock];
       // First stencil node, then the weights in branch-free double arithmetic (a loop of its
@@ -301,7 +300,7 @@ class Gimp : public ShapeFunction<D> {
         const int i0 = first[p];
         for (int j = 0; j < M; ++j) {
           const int i = i0 + j;
-          ax.node[d][j][p] = ((i < 0 ? 0 : (i > n ? n : i)) - lo) * stride;  // the box's (Grid)
+          ax.set_node(g, d, j, p, i < 0 ? 0 : (i > n ? n : i));
         }
       }
       ax.offsets(g, d, x, count, out);
