@@ -33,6 +33,34 @@ inline std::pair<int, int> split_range(int n, int parts, int index) {
   return {lo, lo + base + (index < extra ? 1 : 0)};
 }
 
+/// The 3^D - 1 offsets of the blocks around one (each component -1, 0 or 1; diagonals
+/// included), in a fixed order: the order in which neighbours are served.
+template <int D>
+std::vector<std::array<int, D>> neighbour_offsets() {
+  std::vector<std::array<int, D>> offsets;
+  int count = 1;
+  for (int d = 0; d < D; ++d) count *= 3;
+  for (int o = 0; o < count; ++o) {
+    std::array<int, D> off{};
+    bool self = true;
+    for (int d = 0, r = o; d < D; ++d, r /= 3) {
+      off[size_t(d)] = r % 3 - 1;
+      self = self && off[size_t(d)] == 0;
+    }
+    if (!self) offsets.push_back(off);
+  }
+  return offsets;
+}
+
+/// The tag of a message travelling by `offset` from sender to receiver (sign -1: by -offset,
+/// what a receiver expects from its neighbour at `offset`), 0 .. 3^D - 1.
+template <int D>
+int direction_tag(const std::array<int, D>& offset, int sign) {
+  int t = 0;
+  for (int d = D - 1; d >= 0; --d) t = 3 * t + (sign * offset[size_t(d)] + 1);
+  return t;
+}
+
 /// A box of grid nodes [lo, hi) per axis (global node indices), walked x fastest.
 template <int D>
 struct NodeBox {
@@ -168,17 +196,15 @@ class Decomposition {
   std::vector<Neighbour> neighbours_;
 
   void find_neighbours() {
-    constexpr int kOffsets = D == 1 ? 3 : D == 2 ? 9 : 27;
-    for (int o = 0; o < kOffsets; ++o) {
+    for (const auto& offset : neighbour_offsets<D>()) {
       Neighbour n;
-      bool self = true, inside = true;
-      for (int d = 0, r = o; d < D; ++d, r /= 3) {
-        n.offset[d] = r % 3 - 1;
-        n.coords[d] = coords_[d] + n.offset[d];
-        self = self && n.offset[d] == 0;
+      n.offset = offset;
+      bool inside = true;
+      for (int d = 0; d < D; ++d) {
+        n.coords[d] = coords_[d] + offset[size_t(d)];
         inside = inside && n.coords[d] >= 0 && n.coords[d] < dims_[d];
       }
-      if (self || !inside) continue;
+      if (!inside) continue;
       box_.intersect(owned_of(n.coords)).for_each([&](const std::array<int, D>& ijk) {
         n.ghosts.push_back(box_.local_index(ijk));
       });

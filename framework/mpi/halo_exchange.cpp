@@ -3,17 +3,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "mpi_error.hpp"
+
 namespace loam {
 
 namespace {
-
-/// The tag of a message travelling by `offset` (from the sender to the receiver): 0 .. 3^D - 1.
-template <int D>
-int offset_tag(const std::array<int, D>& offset, int sign) {
-  int t = 0;
-  for (int d = D - 1; d >= 0; --d) t = 3 * t + (sign * offset[d] + 1);
-  return t;
-}
 
 int values_per_node(const std::vector<NodalArray>& arrays) {
   int n = 0;
@@ -49,10 +43,6 @@ void unpack(const std::vector<NodalArray>& arrays, const std::vector<size_t>& no
   }
 }
 
-void check(int code, const char* what) {
-  if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI error in ") + what);
-}
-
 }  // namespace
 
 template <int D>
@@ -60,9 +50,9 @@ HaloExchange<D>::HaloExchange(MPI_Comm comm, const Decomposition<D>& decompositi
     : comm_(comm), threads_(threads) {
   for (const auto& n : decomposition.neighbours()) {
     Link l;
-    check(MPI_Cart_rank(comm, n.coords.data(), &l.rank), "MPI_Cart_rank");
-    l.send_tag = offset_tag<D>(n.offset, 1);   // this rank -> neighbour: travelling by +offset
-    l.recv_tag = offset_tag<D>(n.offset, -1);  // neighbour -> this rank: travelling by -offset
+    mpi_check(MPI_Cart_rank(comm, n.coords.data(), &l.rank), "MPI_Cart_rank");
+    l.send_tag = direction_tag<D>(n.offset, 1);   // this rank -> neighbour: travelling by +offset
+    l.recv_tag = direction_tag<D>(n.offset, -1);  // neighbour -> this rank: travelling by -offset
     l.ghosts = &n.ghosts;
     l.shared = &n.shared;
     links_.push_back(std::move(l));
@@ -78,22 +68,22 @@ void HaloExchange<D>::exchange(const std::vector<NodalArray>& arrays, bool rever
     Link& l = links_[i];
     const auto& in = reverse ? *l.shared : *l.ghosts;
     l.recv.resize(in.size() * size_t(per_node));
-    check(MPI_Irecv(l.recv.data(), int(l.recv.size()), MPI_DOUBLE, l.rank, l.recv_tag, comm_,
-                    &requests[2 * i]),
-          "MPI_Irecv");
+    mpi_check(MPI_Irecv(l.recv.data(), int(l.recv.size()), MPI_DOUBLE, l.rank, l.recv_tag, comm_,
+                        &requests[2 * i]),
+              "MPI_Irecv");
   }
   for (size_t i = 0; i < links_.size(); ++i) {
     Link& l = links_[i];
     const auto& out = reverse ? *l.ghosts : *l.shared;
     l.send.resize(out.size() * size_t(per_node));
     pack(arrays, out, l.send.data(), per_node, threads_);
-    check(MPI_Isend(l.send.data(), int(l.send.size()), MPI_DOUBLE, l.rank, l.send_tag, comm_,
-                    &requests[2 * i + 1]),
-          "MPI_Isend");
+    mpi_check(MPI_Isend(l.send.data(), int(l.send.size()), MPI_DOUBLE, l.rank, l.send_tag, comm_,
+                        &requests[2 * i + 1]),
+              "MPI_Isend");
     messages_ += 1;
     bytes_ += long(l.send.size() * sizeof(double));
   }
-  check(MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
+  mpi_check(MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
   // In the fixed neighbour order: the owners' sums are the same bits on every run.
   for (const Link& l : links_)
     unpack(arrays, reverse ? *l.shared : *l.ghosts, l.recv.data(), per_node, reverse, threads_);

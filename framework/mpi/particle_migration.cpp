@@ -3,21 +3,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "mpi_error.hpp"
+
 namespace loam {
 
 namespace {
-
-/// The tag of a message travelling by `offset` (sender to receiver); 0 .. 3^D - 1.
-template <int D>
-int direction_tag(const std::array<int, D>& offset, int sign) {
-  int t = 0;
-  for (int d = D - 1; d >= 0; --d) t = 3 * t + (sign * offset[d] + 1);
-  return t;
-}
-
-void check(int code, const char* what) {
-  if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI error in ") + what);
-}
 
 /// The values a particle carries: every allocated field's components in registry order, then
 /// id, material and body (integers below 2^53: exact as doubles).
@@ -56,19 +46,17 @@ ParticleMigration<D>::ParticleMigration(MPI_Comm comm, const Decomposition<D>& d
                                         const Grid<D>& grid)
     : comm_(comm), dec_(decomposition), grid_(grid) {
   // Every immediate neighbour (not only those sharing nodes: a particle may cross a corner).
-  constexpr int kOffsets = D == 1 ? 3 : D == 2 ? 9 : 27;
-  for (int o = 0; o < kOffsets; ++o) {
+  for (const auto& offset : neighbour_offsets<D>()) {
     Link l;
+    l.offset = offset;
     std::array<int, D> coords{};
-    bool self = true, inside = true;
-    for (int d = 0, r = o; d < D; ++d, r /= 3) {
-      l.offset[d] = r % 3 - 1;
-      coords[d] = dec_.coords()[d] + l.offset[d];
-      self = self && l.offset[d] == 0;
+    bool inside = true;
+    for (int d = 0; d < D; ++d) {
+      coords[d] = dec_.coords()[d] + offset[size_t(d)];
       inside = inside && coords[d] >= 0 && coords[d] < dec_.dims()[d];
     }
-    if (self || !inside) continue;
-    check(MPI_Cart_rank(comm, coords.data(), &l.rank), "MPI_Cart_rank");
+    if (!inside) continue;
+    mpi_check(MPI_Cart_rank(comm, coords.data(), &l.rank), "MPI_Cart_rank");
     l.send_tag = direction_tag<D>(l.offset, 1);
     l.recv_tag = direction_tag<D>(l.offset, -1);
     links_.push_back(std::move(l));
@@ -121,24 +109,25 @@ void ParticleMigration<D>::migrate(Particles<D>& P) {
   std::vector<MPI_Request> sends(links_.size(), MPI_REQUEST_NULL);
   for (size_t k = 0; k < links_.size(); ++k) {
     Link& l = links_[k];
-    check(MPI_Isend(l.send.data(), int(l.send.size()), MPI_DOUBLE, l.rank, l.send_tag, comm_,
-                    &sends[k]),
-          "MPI_Isend");
+    mpi_check(MPI_Isend(l.send.data(), int(l.send.size()), MPI_DOUBLE, l.rank, l.send_tag, comm_,
+                        &sends[k]),
+              "MPI_Isend");
     messages_ += 1;
     bytes_ += long(l.send.size() * sizeof(double));
   }
   for (auto& l : links_) {
     MPI_Status status;
-    check(MPI_Probe(l.rank, l.recv_tag, comm_, &status), "MPI_Probe");
+    mpi_check(MPI_Probe(l.rank, l.recv_tag, comm_, &status), "MPI_Probe");
     int count = 0;
-    check(MPI_Get_count(&status, MPI_DOUBLE, &count), "MPI_Get_count");
+    mpi_check(MPI_Get_count(&status, MPI_DOUBLE, &count), "MPI_Get_count");
     if (count % per != 0)
       throw std::runtime_error("particle migration: the ranks disagree on the particle fields");
     l.recv.resize(size_t(count));
-    check(MPI_Recv(l.recv.data(), count, MPI_DOUBLE, l.rank, l.recv_tag, comm_, MPI_STATUS_IGNORE),
-          "MPI_Recv");
+    mpi_check(
+        MPI_Recv(l.recv.data(), count, MPI_DOUBLE, l.rank, l.recv_tag, comm_, MPI_STATUS_IGNORE),
+        "MPI_Recv");
   }
-  check(MPI_Waitall(int(sends.size()), sends.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
+  mpi_check(MPI_Waitall(int(sends.size()), sends.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
   P.erase(leaving);
   size_t arriving = 0;
   for (const auto& l : links_) arriving += l.recv.size() / size_t(per);
