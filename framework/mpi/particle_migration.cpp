@@ -87,8 +87,10 @@ int ParticleMigration<D>::link_of(const std::array<int, D>& cell) const {
 }
 
 template <int D>
-void ParticleMigration<D>::migrate(Particles<D>& P) {
+long ParticleMigration<D>::migrate(Particles<D>& P) {
   const int per = values_per_particle(P);
+  long strays = 0;
+  first_stray_ = -1;
   for (auto& l : links_) l.send.clear();
   std::vector<uint8_t> leaving(P.size(), 0);
   for (size_t i = 0; i < P.size(); ++i) {
@@ -96,10 +98,11 @@ void ParticleMigration<D>::migrate(Particles<D>& P) {
     for (int d = 0; d < D; ++d) cell[d] = grid_.cell_of(P.col(P.position, d)[i], d);
     const int k = link_of(cell);
     if (k == -1) continue;
-    if (k == -2)
-      throw std::runtime_error("particle " + std::to_string(P.id[i]) +
-                               " moved beyond the neighbouring blocks in one step (a rank's "
-                               "block is narrower than a step's move: use fewer ranks)");
+    if (k == -2) {  // kept here and reported: the other ranks are already on their way to receive
+      if (strays == 0) first_stray_ = long(P.id[i]);
+      ++strays;
+      continue;
+    }
     pack_particle(P, i, links_[size_t(k)].send);
     leaving[i] = 1;
     particles_ += 1;
@@ -136,6 +139,7 @@ void ParticleMigration<D>::migrate(Particles<D>& P) {
   for (const auto& l : links_)
     for (size_t q = 0; q < l.recv.size(); q += size_t(per))
       unpack_particle(l.recv.data() + q, P, i++);
+  return strays;
 }
 
 template class ParticleMigration<1>;

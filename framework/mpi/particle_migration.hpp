@@ -7,8 +7,9 @@
 // received from that neighbour by rank and tag (no MPI_ANY_SOURCE), appended in the fixed
 // neighbour order, so a run is the same bits at a given rank count. A particle may cross into
 // an immediate neighbour only (3^D - 1 around, diagonals included): explicit MPM moves it less
-// than a cell per step and a block is at least a ghost layer wide; a longer jump is an error
-// naming the particle.
+// than a cell per step and a block is at least a ghost layer wide. A particle that jumped
+// further stays where it is and is reported (migrate's count, first_stray()): the caller folds
+// it into the step's collective stability check, so no rank stops while the others wait.
 #include <mpi.h>
 
 #include "framework/decomposition.hpp"
@@ -23,9 +24,12 @@ class ParticleMigration {
   ParticleMigration(MPI_Comm comm, const Decomposition<D>& decomposition, const Grid<D>& grid);
 
   /// Send away the particles of P in cells this rank does not own and append those received.
-  /// Every rank of `comm` calls it (collective over the neighbours). std::runtime_error naming
-  /// the particle if one left the neighbourhood.
-  void migrate(Particles<D>& P);
+  /// Every rank of `comm` calls it (collective over the neighbours). Returns the particles that
+  /// moved beyond the neighbouring blocks (kept, not sent; first_stray() names the first), 0
+  /// normally; std::runtime_error if the ranks' particle fields differ.
+  long migrate(Particles<D>& P);
+  /// The id of the first particle the last migration could not place, or -1.
+  long first_stray() const { return first_stray_; }
 
   /// Over every migration so far: particles and messages this rank sent, and bytes.
   long particles_sent() const { return particles_; }
@@ -44,7 +48,7 @@ class ParticleMigration {
     std::vector<double> send, recv;
   };
   std::vector<Link> links_;
-  long particles_ = 0, messages_ = 0, bytes_ = 0;
+  long particles_ = 0, messages_ = 0, bytes_ = 0, first_stray_ = -1;
 
   /// The link to the rank owning cell `cell`, or -1 for this rank; -2 outside the neighbourhood.
   int link_of(const std::array<int, D>& cell) const;

@@ -70,7 +70,7 @@ void migration_case() {
   long left_before = 0;
   for (size_t i = 0; i < P.size(); ++i) left_before += !dec.owns_cell(cell_of(P, i));
   loam::ParticleMigration<D> migration(cart, dec, g);
-  migration.migrate(P);
+  const long strays = migration.migrate(P);
   const long sent_first = migration.particles_sent();
   // Count, ids, ownership, fields.
   const long n = long(serial.size());
@@ -97,7 +97,7 @@ void migration_case() {
   for (long s : all) not_once += s != 1;
   const long total = global_sum(long(P.size()));
   // A second migration: nothing is misplaced, nothing moves.
-  migration.migrate(P);
+  const long strays_second = migration.migrate(P);
   const long sent_second = migration.particles_sent() - sent_first;
   const long messages = migration.messages_sent();
   const long crossed = global_sum(left_before);
@@ -105,8 +105,8 @@ void migration_case() {
       std::to_string(D) + "D, " + std::to_string(size) + " ranks (" + dims_name(dims) + ")";
   // Collectives on every rank, printed by rank 0.
   const long misplaced_all = global_sum(misplaced), differing_all = global_sum(differing),
-             sent_second_all = global_sum(sent_second),
-             max_messages = global_max(messages) / 2, bytes = global_sum(migration.bytes_sent());
+             sent_second_all = global_sum(sent_second), max_messages = global_max(messages) / 2,
+             bytes = global_sum(migration.bytes_sent());
   if (me == 0)
     std::printf(
         "migration %-18s %ld particles, %ld crossed a block boundary; after: %ld in total, ids "
@@ -116,6 +116,7 @@ void migration_case() {
         name.c_str(), n, crossed, total, not_once, misplaced_all, differing_all, sent_second_all,
         max_messages, bytes);
   check(size == 1 || crossed > 0, name + ": particles crossed block boundaries");
+  check(global_sum(strays + strays_second) == 0, name + ": no particle beyond the neighbours");
   check(total == n, name + ": particle count unchanged");
   check(not_once == 0, name + ": every id on exactly one rank");
   check(misplaced_all == 0, name + ": every particle on the rank owning its cell");
@@ -123,6 +124,22 @@ void migration_case() {
   check(sent_second_all == 0, name + ": a second migration moves nothing");
   check(messages == 2L * migration.neighbours(),
         name + ": one message per neighbour and migration");
+  // A particle thrown beyond the neighbouring blocks (rank 0's first, to the far end of the
+  // grid, with at least 3 blocks along x) stays and is reported; every rank completes.
+  if (dims[0] >= 3) {
+    long thrown = -1;
+    if (coords[0] == 0 && P.size() > 0) {
+      thrown = long(P.id[0]);
+      P.col(P.position, 0)[0] = g.upper(0) - 1e-3;
+    }
+    const long stray = migration.migrate(P);
+    const bool reported = thrown < 0 ? stray == 0 : stray == 1 && migration.first_stray() == thrown;
+    if (me == 0)
+      std::printf("migration %-18s a particle thrown across %d blocks: kept and reported: %s\n",
+                  name.c_str(), dims[0] - 1, reported ? "yes" : "NO");
+    check(reported, name + ": a particle beyond the neighbours is kept and reported");
+    check(global_sum(long(P.size())) == n, name + ": and no particle is lost");
+  }
   MPI_Comm_free(&cart);
 }
 
