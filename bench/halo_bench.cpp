@@ -11,24 +11,22 @@
 #include <vector>
 
 #include "framework/decomposition.hpp"
+#include "framework/mpi/cartesian_ranks.hpp"
 #include "framework/mpi/halo_exchange.hpp"
 
 namespace {
 
 template <int D>
 void bench_block(const char* name, const std::array<int, D>& cells, double h) {
-  int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
   loam::Grid<D> g;
   std::array<double, D> origin{}, extent{}, cell{};
   for (int d = 0; d < D; ++d) extent[size_t(d)] = cells[size_t(d)] * h, cell[size_t(d)] = h;
   g.init(origin, extent, cell);
-  std::array<int, D> dims{}, periods{}, coords{};
-  MPI_Dims_create(size, D, dims.data());
-  MPI_Comm cart;
-  MPI_Cart_create(MPI_COMM_WORLD, D, dims.data(), periods.data(), 0, &cart);
-  MPI_Cart_coords(cart, rank, D, coords.data());
+  const loam::CartesianRanks<D> ranks(MPI_COMM_WORLD);
+  const MPI_Comm cart = ranks.comm();
+  const auto& dims = ranks.dims();
+  const auto& coords = ranks.coords();
+  const int rank = ranks.rank(), size = ranks.size();
   const loam::Decomposition<D> dec(g, dims, coords, 1, 2);
   loam::HaloExchange<D> halo(cart, dec, 1);
   constexpr int S = 1 + 2 * D;
@@ -66,7 +64,6 @@ void bench_block(const char* name, const std::array<int, D>& cells, double h) {
         dec.box().size(), double(msg_max) / steps, double(bytes_max) / steps, batches[3] * 1e6,
         kSteps);
   }
-  MPI_Comm_free(&cart);
 }
 
 }  // namespace

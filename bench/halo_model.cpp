@@ -44,8 +44,6 @@ template <int D>
 void table(const char* name, const std::array<std::array<int, D>, 5>& arrays,
            std::array<int, D> block, double particles_per_cell, double alpha, double beta,
            double tp) {
-  long cells = 1;
-  for (int d = 0; d < D; ++d) cells *= block[size_t(d)];
   const double particles = D == 3 ? 101376 : 102400;
   const double step = particles * tp;
   std::printf("%s (%.0f particles per rank, step %.2f ms of particle work):\n", name, particles,
@@ -72,7 +70,6 @@ void table(const char* name, const std::array<std::array<int, D>, 5>& arrays,
         ranks, hl.messages, hl.bytes, t * 1e6, 100 * t / step, std::round(hi), D,
         std::pow(std::round(hi), D) * particles_per_cell);
   }
-  (void)cells;
 }
 
 }  // namespace

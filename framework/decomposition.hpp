@@ -116,12 +116,15 @@ struct NodeBox {
 template <int D>
 class Decomposition {
  public:
+  /// A block next to this one: its offset (components -1, 0, 1) and rank coordinates.
+  struct Adjacent {
+    std::array<int, D> offset{}, coords{};
+  };
   /// One neighbouring block and the nodes the two share: `ghosts`, nodes of this rank's box the
   /// neighbour owns (sent to it by the reverse exchange, received by the forward one), and
   /// `shared`, owned nodes inside the neighbour's box (received, then sent). Local indices into
   /// this rank's box, in the order both sides walk them.
-  struct Neighbour {
-    std::array<int, D> offset{}, coords{};
+  struct Neighbour : Adjacent {
     std::vector<size_t> ghosts, shared;
   };
 
@@ -188,6 +191,21 @@ class Decomposition {
   const NodeBox<D>& box() const { return box_; }
   /// The neighbouring blocks that share nodes with this one, offsets in lexicographic order.
   const std::vector<Neighbour>& neighbours() const { return neighbours_; }
+  /// Every block next to this one in the rank array (3^D - 1 at most, diagonals included;
+  /// particles may cross into any of them), in neighbour_offsets' order.
+  std::vector<Adjacent> adjacent_blocks() const {
+    std::vector<Adjacent> blocks;
+    for (const auto& offset : neighbour_offsets<D>()) {
+      Adjacent a{offset, {}};
+      bool inside = true;
+      for (int d = 0; d < D; ++d) {
+        a.coords[size_t(d)] = coords_[d] + offset[size_t(d)];
+        inside = inside && a.coords[size_t(d)] >= 0 && a.coords[size_t(d)] < dims_[d];
+      }
+      if (inside) blocks.push_back(a);
+    }
+    return blocks;
+  }
 
  private:
   std::array<int, D> dims_, coords_, cells_{};
@@ -196,15 +214,10 @@ class Decomposition {
   std::vector<Neighbour> neighbours_;
 
   void find_neighbours() {
-    for (const auto& offset : neighbour_offsets<D>()) {
+    for (const auto& a : adjacent_blocks()) {
       Neighbour n;
-      n.offset = offset;
-      bool inside = true;
-      for (int d = 0; d < D; ++d) {
-        n.coords[d] = coords_[d] + offset[size_t(d)];
-        inside = inside && n.coords[d] >= 0 && n.coords[d] < dims_[d];
-      }
-      if (!inside) continue;
+      n.offset = a.offset;
+      n.coords = a.coords;
       box_.intersect(owned_of(n.coords)).for_each([&](const std::array<int, D>& ijk) {
         n.ghosts.push_back(box_.local_index(ijk));
       });

@@ -54,12 +54,6 @@ struct Grid {
     for (int d = 0; d < D; ++d) n += size_t(ijk[d] - node_lo[d]) * size_t(node_stride[d]);
     return n;
   }
-  /// Whether the node with global indices ijk is stored.
-  bool stores_node(const std::array<int, D>& ijk) const {
-    for (int d = 0; d < D; ++d)
-      if (ijk[d] < node_lo[d] || ijk[d] >= node_lo[d] + box_nodes[d]) return false;
-    return true;
-  }
 
   double min_cell() const {
     double h = cell[0];

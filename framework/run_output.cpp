@@ -95,7 +95,7 @@ void Run<D>::check_outputs(Diagnostics& diag) {
         need_disp = need_disp || f[i] == "displacement";
       }
     if (probe.on_node) {
-      size_t idx = 0;
+      std::array<int, D> node{};
       const auto& ijk = pr.vec("node");
       for (int d = 0; d < D; ++d) {
         long k = std::lround(ijk[size_t(d)]);
@@ -105,10 +105,9 @@ void Run<D>::check_outputs(Diagnostics& diag) {
                          " is not an integer in [0, " + std::to_string(sim_->grid.nodes[d] - 1) +
                          "]");
         }
-        idx += size_t(std::max(0L, k - sim_->grid.node_lo[size_t(d)])) *
-               size_t(sim_->grid.node_stride[d]);
+        node[size_t(d)] = int(std::max(0L, k));
       }
-      probe.node = idx;
+      probe.node = sim_->grid.node_index(node);
     } else {
       probe.set = sim_->set_param(pr, "set", diag);
       if (probe.set < 0) continue;

@@ -1,6 +1,6 @@
 #pragma once
 // The halo exchange of nodal quantities between the blocks of a Cartesian decomposition (issue
-// 18; docs/parallel.md; framework/decomposition.hpp), as DESIGN.md "Beyond one machine" asks:
+// 18; docs/parallel.md "Halo exchange"; framework/decomposition.hpp):
 //   reverse: every rank sends the values its particles scattered onto ghost nodes to the
 //            neighbour that owns them, every nodal array of every phase packed in one buffer per
 //            neighbour; the owner adds what it receives in a fixed neighbour order (offsets in
@@ -28,7 +28,8 @@ struct NodalArray {
 template <int D>
 class HaloExchange {
  public:
-  /// `comm`: the Cartesian communicator whose rank coordinates `decomposition` was built for.
+  /// `comm`: the Cartesian communicator whose rank coordinates `decomposition` was built for;
+  /// `decomposition` must outlive the exchange (its links hold the node lists).
   HaloExchange(MPI_Comm comm, const Decomposition<D>& decomposition, int threads = 1);
 
   /// Ghost values added to their owners' (ghosts keep theirs; a forward exchange refreshes them).
@@ -53,7 +54,8 @@ class HaloExchange {
   std::vector<Link> links_;
   long messages_ = 0, bytes_ = 0;
 
-  /// Send `from` nodes' values to every neighbour and receive into the buffers for `to` nodes.
+  /// One message to and from every neighbour: reverse sends the ghosts and adds into the shared
+  /// (owned) nodes, forward sends the shared nodes and overwrites the ghosts.
   void exchange(const std::vector<NodalArray>& arrays, bool reverse);
 };
 

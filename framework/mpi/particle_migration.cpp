@@ -46,17 +46,10 @@ ParticleMigration<D>::ParticleMigration(MPI_Comm comm, const Decomposition<D>& d
                                         const Grid<D>& grid)
     : comm_(comm), dec_(decomposition), grid_(grid) {
   // Every immediate neighbour (not only those sharing nodes: a particle may cross a corner).
-  for (const auto& offset : neighbour_offsets<D>()) {
+  for (const auto& a : dec_.adjacent_blocks()) {
     Link l;
-    l.offset = offset;
-    std::array<int, D> coords{};
-    bool inside = true;
-    for (int d = 0; d < D; ++d) {
-      coords[d] = dec_.coords()[d] + offset[size_t(d)];
-      inside = inside && coords[d] >= 0 && coords[d] < dec_.dims()[d];
-    }
-    if (!inside) continue;
-    mpi_check(MPI_Cart_rank(comm, coords.data(), &l.rank), "MPI_Cart_rank");
+    l.offset = a.offset;
+    mpi_check(MPI_Cart_rank(comm, a.coords.data(), &l.rank), "MPI_Cart_rank");
     l.send_tag = direction_tag<D>(l.offset, 1);
     l.recv_tag = direction_tag<D>(l.offset, -1);
     links_.push_back(std::move(l));

@@ -21,6 +21,7 @@ template <int D>
 class ParticleMigration {
  public:
   /// `comm`: the Cartesian communicator of `decomposition`; `grid`: the whole grid's geometry.
+  /// Both must outlive the migration.
   ParticleMigration(MPI_Comm comm, const Decomposition<D>& decomposition, const Grid<D>& grid);
 
   /// Send away the particles of P in cells this rank does not own and append those received.

@@ -34,16 +34,16 @@ class PointLoad : public Load<D> {
     }
     const auto& g = sim.grid;
     for (int k = 0; k < (1 << D); ++k) {
-      size_t node = 0;
+      std::array<int, D> ijk{};
       double w = 1;
       for (int d = 0; d < D; ++d) {
         int c = g.cell_of(x_[size_t(d)], d);
         double r = (x_[size_t(d)] - g.origin[size_t(d)]) * g.inv_cell[size_t(d)] - c;
         bool up = (k >> d) & 1;
-        node += size_t(c + (up ? 1 : 0) - g.node_lo[size_t(d)]) * size_t(g.node_stride[d]);
+        ijk[size_t(d)] = c + (up ? 1 : 0);
         w *= up ? r : 1 - r;
       }
-      nodes_.push_back(node);
+      nodes_.push_back(g.node_index(ijk));
       weights_.push_back(w);
     }
   }

@@ -128,23 +128,24 @@ class Traction : public Load<D> {
       // Surface point x_p + F (s/2) N (N = +-e_a, so F N is column a of F) and its cell: per
       // axis the lower node and the tent weight of the upper.
       const double half = (face_.upper ? 0.5 : -0.5) * length_[k];
-      size_t base = 0;
+      std::array<int, D> cell{};
       std::array<double, D> frac{};
       for (int d = 0; d < D; ++d) {
         const double x = P.col(P.position, d)[i] + half * P.col(F_, d * D + a)[i];
         const int c = g.cell_of(x, d);
         frac[size_t(d)] =
             std::clamp((x - g.origin[size_t(d)]) * g.inv_cell[size_t(d)] - c, 0.0, 1.0);
-        base += size_t(c - g.node_lo[size_t(d)]) * size_t(g.node_stride[size_t(d)]);
+        cell[size_t(d)] = c;
       }
       for (int corner = 0; corner < (1 << D); ++corner) {
         double w = 1;
-        size_t node = base;
+        std::array<int, D> ijk = cell;
         for (int d = 0; d < D; ++d) {
           const bool up = (corner >> d) & 1;
           w *= up ? frac[size_t(d)] : 1 - frac[size_t(d)];
-          if (up) node += size_t(g.node_stride[size_t(d)]);
+          ijk[size_t(d)] += up ? 1 : 0;
         }
+        const size_t node = g.node_index(ijk);
         for (int d = 0; d < D; ++d) force.at(node, d) += w * s * t_[size_t(d)] * area_[k];
       }
     }

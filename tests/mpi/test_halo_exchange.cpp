@@ -13,6 +13,7 @@
 #include <cstring>
 
 #include "../decomposition_scene.hpp"
+#include "framework/mpi/cartesian_ranks.hpp"
 #include "framework/mpi/halo_exchange.hpp"
 #include "mpi_check.hpp"
 
@@ -52,11 +53,10 @@ void halo_case(const std::string& shape) {
   const int size = loam_mpi_test::size(), g_rank = rank();
   auto sim = loam_test::decomposition_scene<D>(shape);
   const auto& g = sim->grid;
-  std::array<int, D> dims{}, periods{}, coords{};
-  MPI_Dims_create(size, D, dims.data());
-  MPI_Comm cart;
-  MPI_Cart_create(MPI_COMM_WORLD, D, dims.data(), periods.data(), 0, &cart);
-  MPI_Cart_coords(cart, g_rank, D, coords.data());
+  const loam::CartesianRanks<D> ranks(MPI_COMM_WORLD);
+  const MPI_Comm cart = ranks.comm();
+  const auto& dims = ranks.dims();
+  const auto& coords = ranks.coords();
   const loam::Decomposition<D> dec(g, dims, coords, sim->shape->rows_below(),
                                    sim->shape->rows_above());
   loam::HaloExchange<D> halo(cart, dec, 2);
@@ -123,7 +123,6 @@ void halo_case(const std::string& shape) {
   check(total == n_particles, name + ": every particle owned exactly once");
   check(out_all == 0, name + ": every stencil entry inside the rank's box");
   check(one_per_neighbour, name + ": one message per neighbour and exchange");
-  MPI_Comm_free(&cart);
 }
 
 }  // namespace

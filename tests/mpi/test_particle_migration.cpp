@@ -12,6 +12,7 @@
 #include <map>
 
 #include "../decomposition_scene.hpp"
+#include "framework/mpi/cartesian_ranks.hpp"
 #include "framework/mpi/particle_migration.hpp"
 #include "mpi_check.hpp"
 
@@ -46,11 +47,10 @@ void migration_case() {
     P.material[i] = uint16_t(i % 5);
     P.body[i] = uint16_t(i % 3);
   }
-  std::array<int, D> dims{}, periods{}, coords{};
-  MPI_Dims_create(size, D, dims.data());
-  MPI_Comm cart;
-  MPI_Cart_create(MPI_COMM_WORLD, D, dims.data(), periods.data(), 0, &cart);
-  MPI_Cart_coords(cart, me, D, coords.data());
+  const loam::CartesianRanks<D> ranks(MPI_COMM_WORLD);
+  const MPI_Comm cart = ranks.comm();
+  const auto& dims = ranks.dims();
+  const auto& coords = ranks.coords();
   const loam::Decomposition<D> dec(g, dims, coords, 1, 2);
   // The serial copy, moved the same way: the reference by id.
   loam::Particles<D> serial = P;
@@ -140,7 +140,6 @@ void migration_case() {
     check(reported, name + ": a particle beyond the neighbours is kept and reported");
     check(global_sum(long(P.size())) == n, name + ": and no particle is lost");
   }
-  MPI_Comm_free(&cart);
 }
 
 }  // namespace
