@@ -97,6 +97,10 @@ class Boundary {
   static constexpr const char* kind = "boundary";
   virtual ~Boundary() = default;
   virtual void setup(Simulation<D>&, Diagnostics&) {}
+  /// Whether it runs on a grid split over MPI ranks (docs/parallel.md): it reads and writes only
+  /// the particles of this rank and the stored box of nodes, each node as the whole grid's
+  /// value. Default false: a run under mpirun refuses it with a located error.
+  virtual bool runs_on_ranks() const { return false; }
   /// Add face forces to the nodal forces of a step, before the grid update (default: none).
   virtual void add_forces(const GridForces&) const {}
   /// Checkpoints (output.checkpoint): a condition's state measured during the run (e.g. the

@@ -256,6 +256,11 @@ Schema config_schema() {
               "write energies and momentum to history.csv every N steps (0: at frames)")
         .def("0")
         .min(0);
+    o.integer("history_digits",
+              "significant digits of the numbers in history.csv (17: every bit of a double)")
+        .def("12")
+        .min(6)
+        .max(17);
     Schema c;
     c.integer("every_steps", "write a checkpoint every N steps").min(1);
     c.real("every_wall_seconds", "s", "write a checkpoint every T seconds of wall time").positive();

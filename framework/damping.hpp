@@ -21,6 +21,10 @@ class Damping {
   static constexpr const char* kind = "damping";
   virtual ~Damping() = default;
   virtual void apply(Simulation<D>&, const NodeForces&) = 0;
+  /// Whether it runs on a grid split over MPI ranks (docs/parallel.md): it reads and writes only
+  /// the particles of this rank and the stored box of nodes, each node as the whole grid's
+  /// value. Default false: a run under mpirun refuses it with a located error.
+  virtual bool runs_on_ranks() const { return false; }
 };
 
 }  // namespace loam

@@ -21,6 +21,10 @@ class Load {
   virtual void apply_to_grid(Simulation<D>&, const NodalVector& /*force*/, double /*t*/) {}
   /// Whether this load writes particle external forces (the field is allocated only then).
   virtual bool uses_particle_forces() const { return false; }
+  /// Whether it runs on a grid split over MPI ranks (docs/parallel.md): it reads and writes only
+  /// the particles of this rank and the stored box of nodes, each node as the whole grid's
+  /// value. Default false: a run under mpirun refuses it with a located error.
+  virtual bool runs_on_ranks() const { return false; }
 };
 
 /// Linear ramp from 0 at t=0 to 1 at t=ramp_time (1 throughout if ramp_time is 0).

@@ -11,6 +11,9 @@
 #include "element_test.hpp"
 #include "launch.hpp"
 #include "runner.hpp"
+#ifdef LOAM_WITH_MPI
+#include "mpi/mpi_ranks.hpp"
+#endif
 
 int main(int argc, char** argv) {
   CLI::App app{"loam: explicit Material Point Method for geomechanics"};
@@ -105,10 +108,19 @@ int main(int argc, char** argv) {
   }
   spdlog::set_pattern("[%H:%M:%S] %^%l%$ %v");
 
-  // Under mpirun -np N > 1: refuse the commands that compute, before they write anything.
+  // Under mpirun -np N > 1: refuse the commands that cannot run on ranks, before they write
+  // anything.
+#ifdef LOAM_WITH_MPI
+  const bool mpi_run = true;
+#else
+  const bool mpi_run = false;
+#endif
   for (auto* cmd : {run, element, bench, compare})
-    if (*cmd) {
-      const std::string refusal = loam::refuse_mpi_launch(cmd->get_name());
+    if (*cmd && !(cmd == run && mpi_run)) {
+      const std::string refusal = loam::refuse_mpi_launch(
+          cmd->get_name(), cmd == run ? "Build loam with MPI (tools/setup.sh --mpi) to run it "
+                                        "on ranks, or run it without mpirun"
+                                      : "Run it without mpirun");
       if (!refusal.empty()) {
         fputs(refusal.c_str(), stderr);
         return 2;
@@ -117,6 +129,21 @@ int main(int argc, char** argv) {
 
   if (*run) {
     if (run_opt.quiet) spdlog::set_level(spdlog::level::warn);
+#ifdef LOAM_WITH_MPI
+    if (loam::mpi_launch_size() > 0) {  // mpirun: the run is split over its ranks
+      try {
+        loam::MpiSession mpi(argc, argv);
+        if (mpi.rank() != 0) {
+          run_opt.report = false;
+          spdlog::set_level(spdlog::level::off);
+        }
+        return loam::run_file(run_file, run_opt);
+      } catch (const std::exception& e) {
+        fprintf(stderr, "loam: error: %s\n", e.what());
+        loam::mpi_abort(1);
+      }
+    }
+#endif
     return loam::run_file(run_file, run_opt);
   }
   if (*check) {

@@ -21,18 +21,18 @@ namespace fs = std::filesystem;
 /// A CSV written under a temporary name and renamed when complete.
 class CsvFile {
  public:
-  void open(const fs::path& path) {
+  void open(const fs::path& path, int digits = 12) {
     final_ = path;
     tmp_ = path;
     tmp_ += ".tmp";
     out_.open(tmp_);
-    out_.precision(12);
+    out_.precision(digits);
     register_temporary_file(tmp_.string());  // removed if a second signal stops the run
   }
   std::ofstream& out() { return out_; }
   /// Open for a resumed run: the rows of the existing file whose first column (the step) is at
   /// most max_step, with its header, are copied into the temporary file, which goes on.
-  void open_resume(const fs::path& path, long max_step) {
+  void open_resume(const fs::path& path, long max_step, int digits = 12) {
     std::vector<std::string> keep;
     {
       std::ifstream in(path);
@@ -42,7 +42,7 @@ class CsvFile {
         if (!line.empty() && std::stol(line.substr(0, line.find(','))) <= max_step)
           keep.push_back(line);
     }
-    open(path);
+    open(path, digits);
     for (const auto& l : keep) out_ << l << "\n";
   }
   /// A failed write (the stream's state after a buffer flush) as WriteError naming the file.
@@ -158,6 +158,8 @@ class Run {
   // Output (run_output.cpp).
   void check_outputs(Diagnostics& diag);
   std::string prepare_directory();
+  /// The output directory: --out, or results/<config name>.
+  fs::path output_directory() const;
   void refresh_derived();
   /// The strain_magnitude output of particle i (hencky_strain_norm since the last reset).
   double strain_magnitude(const Particles<D>& p, size_t i) const;
@@ -188,6 +190,12 @@ class Run {
 
   // The loop and summary.json (runner.cpp).
   nlohmann::json base_summary() const;
+  /// The particle count of every set over all ranks (collective under mpirun).
+  double global_particles() const {
+    double n = double(sim_->num_particles());
+    sim_->ranks->sum(&n, 1);
+    return n;
+  }
   RunResult loop();
 };
 

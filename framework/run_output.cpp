@@ -155,11 +155,25 @@ void Run<D>::check_outputs(Diagnostics& diag) {
     if (n == "displacement") frame_fields_.push_back(displacement_);
     if (n == "strain_magnitude") frame_fields_.push_back(strain_magnitude_);
   }
+  if (sim_->ranks->distributed()) {  // what the output cannot do under mpirun yet
+    const std::string only = " does not run under mpirun yet (docs/parallel.md lists what does)";
+    if (out.given("checkpoint"))
+      diag.error(out.where("checkpoint"), out.path("checkpoint"), "checkpoint" + only);
+    const Params& w = out.section("writer");
+    if (w.has("grid") && w.flag("grid"))
+      diag.error(w.where("grid"), w.path("grid"), "the grid output" + only);
+    if (!opt_.resume.empty()) diag.error(cfg_.params.where(), "--resume", "--resume" + only);
+  }
+}
+
+template <int D>
+fs::path Run<D>::output_directory() const {
+  return opt_.out_dir.empty() ? fs::path("results") / cfg_.name : fs::path(opt_.out_dir);
 }
 
 template <int D>
 std::string Run<D>::prepare_directory() {
-  dir_ = opt_.out_dir.empty() ? fs::path("results") / cfg_.name : fs::path(opt_.out_dir);
+  dir_ = output_directory();
   std::error_code ec;
   if (fs::exists(dir_) && !fs::is_directory(dir_))
     return "output path " + dir_.string() + " is a file";
@@ -211,12 +225,14 @@ template <int D>
 void Run<D>::open_outputs(long resume_step) {
   writer_ = Registry::instance().create<Writer, D>(cfg_.params.section("output").section("writer"));
   writer_->open(dir_.string(), *sim_, frame_fields_);
+  if (!sim_->ranks->root()) return;  // history and probes are the first rank's
+  const int history_digits = int(cfg_.params.section("output").integer("history_digits"));
   if (resume_step >= 0) {  // the files go on from the checkpoint's step
-    history_.open_resume(dir_ / "history.csv", resume_step);
+    history_.open_resume(dir_ / "history.csv", resume_step, history_digits);
     for (auto& pr : probes_) pr.csv.open_resume(dir_ / ("probe_" + pr.name + ".csv"), resume_step);
     return;
   }
-  history_.open(dir_ / "history.csv");
+  history_.open(dir_ / "history.csv", history_digits);
   history_.out() << "step,time,dt,kinetic_energy,strain_energy,gravity_energy,total_energy";
   for (int d = 0; d < D; ++d)
     history_.out() << ",momentum_"
@@ -294,7 +310,8 @@ void Run<D>::sample_probes(bool force) {
 
 template <int D>
 void Run<D>::write_history() {
-  Energies e = sim_->energies();
+  Energies e = sim_->energies();  // over all ranks: every rank calls this
+  if (!sim_->ranks->root()) return;
   auto& o = history_.out();
   double strain = std::isnan(e.strain) ? 0.0 : e.strain;
   o << sim_->step << "," << sim_->time << "," << sim_->dt << "," << e.kinetic << "," << e.strain

@@ -122,7 +122,10 @@ RunResult Run<D>::execute(bool check_only) {
     return loop();
   }
   if (opt_.write_output) {
-    std::string err = prepare_directory();
+    // Under mpirun the first rank prepares the directory and the others wait for its verdict.
+    const Ranks<D>& ranks = *sim_->ranks;
+    std::string err = ranks.root() ? prepare_directory() : (dir_ = output_directory(), "");
+    if (ranks.distributed()) err = ranks.first_message(err);
     if (!err.empty()) {
       res.exit_code = 2;
       res.message = "loam: error: " + err + "\n";
@@ -393,7 +396,7 @@ nlohmann::json Run<D>::base_summary() const {
   s["config_file"] = cfg_.file;
   s["config"] = cfg_.params.to_json();
   s["dimension"] = D;
-  s["particles"] = sim_->num_particles();
+  s["particles"] = global_particles();
   nlohmann::json sets = nlohmann::json::object();
   for (const auto& set : sim_->sets) {
     std::vector<std::string> bodies;
@@ -404,9 +407,11 @@ nlohmann::json Run<D>::base_summary() const {
     for (size_t i = 0; i < P.size(); ++i)
       for (int d = 0; d < D; ++d)
         kinetic += 0.5 * P.col(P.mass)[i] * std::pow(P.col(P.velocity, d)[i], 2);
-    sets[set.name] = {{"particles", set.size()},
-                      {"mass", set.mass()},
-                      {"kinetic_energy", kinetic},
+    double totals[3] = {double(set.size()), set.mass(), kinetic};  // over the ranks
+    sim_->ranks->sum(totals, 3);
+    sets[set.name] = {{"particles", size_t(totals[0])},
+                      {"mass", totals[1]},
+                      {"kinetic_energy", totals[2]},
                       {"bodies", bodies},
                       {"bytes_per_particle", set.particles.bytes_per_particle()}};
   }
@@ -415,10 +420,13 @@ nlohmann::json Run<D>::base_summary() const {
   s["nodes"] = sim_->grid.num_nodes;
   s["shape_function"] = sim_->config.section("shape_function").type();
   s["scheme"] = sim_->config.section("scheme").type();
-  size_t bytes = 0;
-  for (const auto& set : sim_->sets) bytes += set.size() * set.particles.bytes_per_particle();
-  s["bytes_per_particle"] = sim_->num_particles() ? bytes / sim_->num_particles()
-                                                  : sim_->sets[0].particles.bytes_per_particle();
+  double bytes = 0;
+  for (const auto& set : sim_->sets)
+    bytes += double(set.size()) * double(set.particles.bytes_per_particle());
+  sim_->ranks->sum(&bytes, 1);
+  const double particles = global_particles();
+  s["bytes_per_particle"] =
+      particles > 0 ? size_t(bytes / particles) : sim_->sets[0].particles.bytes_per_particle();
   return s;
 }
 
@@ -511,6 +519,7 @@ RunResult Run<D>::loop() {
   int interrupted = 0;  // the signal that stopped the run (InterruptGuard)
   const bool keep_good_image = files && sim.keep_last_good && checkpointing();
   const int num_stages = int(sim.stages.size());
+  const bool distributed = sim.ranks->distributed();
   bool budget = false;           // --max-steps reached
   std::string stopped_by_stage;  // a stage that did not reach static (if_not_static: stop)
   bool within_stage = resuming;  // resumed within stage ls_.stage: it has begun already
@@ -605,9 +614,11 @@ RunResult Run<D>::loop() {
           }
           if (keep_good_image && sim.last_good.step == sim.step) good_image_ = checkpoint_image();
         });
+      if (distributed) write_error = sim.ranks->first_message(write_error);
       if (!write_error.empty()) break;
       auto now = Clock::now();
-      if (!opt_.quiet && std::chrono::duration<double>(now - last_report).count() > 3.0) {
+      if (!opt_.quiet && opt_.report &&
+          std::chrono::duration<double>(now - last_report).count() > 3.0) {
         double el = std::chrono::duration<double>(now - t0).count();
         double sps = double(sim.step - steps_at_report) /
                      std::chrono::duration<double>(now - last_report).count();
@@ -618,7 +629,9 @@ RunResult Run<D>::loop() {
         last_report = now;
         steps_at_report = sim.step;
       }
-      if ((interrupted = InterruptGuard::requested()) != 0) break;
+      interrupted = InterruptGuard::requested();
+      if (distributed) interrupted = sim.ranks->max(interrupted);  // every rank stops together
+      if (interrupted != 0) break;
       if (reached_static) break;
     }
     within_stage = false;
@@ -689,15 +702,19 @@ RunResult Run<D>::loop() {
   res.summary["end_time"] = sim.time;
   res.summary["wall_seconds"] = wall;
   res.summary["threads"] = sim.threads;
+  const double particles = global_particles();
+  if (distributed) wall = sim.ranks->max(wall);
   res.summary["particle_steps_per_second"] =
-      wall > 0 ? double(sim.num_particles()) * double(sim.step + srf_steps_) / wall : 0.0;
+      wall > 0 ? particles * double(sim.step + srf_steps_) / wall : 0.0;
+  if (distributed) res.summary["ranks"] = sim.ranks->size();
   res.summary["dt_min"] = ls_.dt_min < 1e300 ? ls_.dt_min : 0.0;
   res.summary["dt_max"] = ls_.dt_max;
   res.summary["frames"] = frames_;
   if (sim.profiling) res.summary["profile_seconds"] = sim.profile;
   Energies e1 = sim.energies();
   // Sources and sinks: counts and the mass balance (round-off when nothing is lost).
-  const double mass_now = sim.total_mass();
+  double mass_now = sim.total_mass();
+  if (distributed) sim.ranks->sum(&mass_now, 1);
   res.summary["particles_created"] = sim.created;
   res.summary["particles_removed"] = sim.removed;
   res.summary["mass"] = {
@@ -794,7 +811,10 @@ RunResult Run<D>::loop() {
       res.summary["status"] = "write_failed";
       res.summary["write_error"] = write_error;
     }
-    if (write_error.empty()) {
+    if (distributed) write_error = sim.ranks->first_message(write_error);
+    if (!sim.ranks->root()) {
+      // summary.json is the first rank's
+    } else if (write_error.empty()) {
       guarded([&] { write_summary(res.summary); });
       if (!write_error.empty()) {  // only summary.json failed
         res.exit_code = 4;
@@ -807,11 +827,12 @@ RunResult Run<D>::loop() {
       }
     }
   }
-  if (!opt_.quiet && failure.empty() && !interrupted)
+  if (!opt_.quiet && opt_.report && failure.empty() && !interrupted)
     spdlog::info(
-        "done: {} steps, {} particles, {:.3g} s wall, {:.3g} M particle-steps/s on {} thread(s)",
-        sim.step, sim.num_particles(), wall,
-        res.summary["particle_steps_per_second"].get<double>() / 1e6, sim.threads);
+        "done: {} steps, {} particles, {:.3g} s wall, {:.3g} M particle-steps/s on {} thread(s){}",
+        sim.step, particles, wall, res.summary["particle_steps_per_second"].get<double>() / 1e6,
+        sim.threads,
+        distributed ? fmt::format(" x {} MPI rank(s)", sim.ranks->size()) : std::string());
   return res;
 }
 
@@ -855,11 +876,11 @@ int run_file(const std::string& file, const RunOptions& opt) {
   Diagnostics diag;
   LoadedConfig cfg = load_config(file, opt.overrides, diag);
   if (!diag.ok()) {
-    fputs(diag.format().c_str(), stderr);
+    if (opt.report) fputs(diag.format().c_str(), stderr);
     return 2;
   }
   RunResult r = run_config(cfg, opt);
-  if (!r.message.empty()) fputs(r.message.c_str(), stderr);
+  if (!r.message.empty() && opt.report) fputs(r.message.c_str(), stderr);
   return r.exit_code;
 }
 

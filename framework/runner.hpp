@@ -21,6 +21,9 @@ struct RunOptions {
   /// Continue the run whose output directory (its newest checkpoint) or checkpoint file this
   /// names; the output goes on in that directory.
   std::string resume;
+  /// Print errors and progress (false on every MPI rank but the first: each rank runs the same
+  /// loop and would say the same).
+  bool report = true;
 };
 
 struct RunResult {

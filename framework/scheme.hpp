@@ -59,6 +59,10 @@ class Scheme {
   virtual void add_energies(const Simulation<D>&, Energies&) const {}
   /// Nodal fields for optional grid output.
   virtual std::vector<GridFieldView> grid_fields() const { return {}; }
+  /// Whether it runs on a grid split over MPI ranks (docs/parallel.md): it reads and writes only
+  /// the particles of this rank and the stored box of nodes, each node as the whole grid's
+  /// value. Default false: a run under mpirun refuses it with a located error.
+  virtual bool runs_on_ranks() const { return false; }
 };
 
 /// The `flip` parameter shared by the schemes: FLIP fraction of the particle velocity update.

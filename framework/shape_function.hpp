@@ -65,6 +65,10 @@ class ShapeFunction {
   /// [r - rows_below(), r + rows_above()]. Used to colour slabs for race-free scatter.
   virtual int rows_below() const = 0;
   virtual int rows_above() const = 0;
+  /// Whether it runs on a grid split over MPI ranks (docs/parallel.md): it reads and writes only
+  /// the particles of this rank and the stored box of nodes, each node as the whole grid's
+  /// value. Default false: a run under mpirun refuses it with a located error.
+  virtual bool runs_on_ranks() const { return false; }
   /// Request particle fields (e.g. particle domain sizes) and check the set-up.
   virtual void setup(Simulation<D>&, Diagnostics&) {}
   /// Initialise its fields of particles [begin, end) of a set: every particle at set-up, and

@@ -28,7 +28,8 @@ double Simulation<D>::stable_dt() const {
   if (fixed_dt > 0) return fixed_dt;
   const double c = wave_speed();
   double dt_cfl = cfl * grid.min_cell() / std::max(c + max_speed, 1e-300);
-  return std::min(dt_cfl, scheme->stable_dt(*this));
+  const double dt_here = std::min(dt_cfl, scheme->stable_dt(*this));
+  return ranks->distributed() ? ranks->min(dt_here) : dt_here;
 }
 
 template <int D>
@@ -43,19 +44,40 @@ bool Simulation<D>::advance(double step_dt, bool check) {
   scheme->step(*this, dt);
   time += dt;
   ++step;
+  const bool distributed = ranks->distributed();
+  if (distributed) failure = ranks->first_message(failure);  // one rank's failure stops all
   if (!failure.empty()) return false;
   if (track) timed("motion", [&] { motion_speed = largest_move(dt); });
   exchange_particles();
+  if (distributed) timed("migration", [&] { migrate_particles(); });
   // Check before sorting: the sort must not see non-finite positions.
   if (checked) {
     bool ok = true;
-    timed("check_particles", [&] { ok = check_particles(failure); });
+    timed("check_particles", [&] { ok = failure.empty() && check_particles(failure); });
+    if (distributed) failure = ranks->first_message(failure), ok = failure.empty();
     if (!ok) return false;
     checked_step = step;
+  } else if (distributed) {
+    failure = ranks->first_message(failure);  // a particle that could not be handed over
+    if (!failure.empty()) return false;
   }
   timed("partition", [&] { maintain_partition(); });
   if (checked && keep_last_good) timed("last_good_copy", [&] { save_last_good(); });
   return true;
+}
+
+template <int D>
+void Simulation<D>::migrate_particles() {
+  for (auto& s : sets) {
+    long strays = 0, first = -1;
+    if (ranks->migrate(s.particles, strays, first)) s.resized = true;
+    if (strays > 0 && failure.empty())
+      failure = "particle " + std::to_string(first) + " of set '" + s.name +
+                "' moved beyond the neighbouring rank's block in one step (" +
+                std::to_string(strays) + " such particles on rank " +
+                std::to_string(ranks->rank()) +
+                "): a particle crossed more than a block; use fewer ranks or a smaller time.cfl";
+  }
 }
 
 template <int D>
@@ -278,6 +300,13 @@ Energies Simulation<D>::energies() const {
     }
   }
   scheme->add_energies(*this, e);
+  if (ranks->distributed()) {  // the whole model's, on every rank
+    std::vector<double> v{e.kinetic, e.strain, e.gravity};
+    v.insert(v.end(), e.momentum.begin(), e.momentum.end());
+    ranks->sum(v.data(), int(v.size()));
+    e.kinetic = v[0], e.strain = v[1], e.gravity = v[2];
+    std::copy(v.begin() + 3, v.end(), e.momentum.begin());
+  }
   return e;
 }
 

@@ -22,6 +22,7 @@
 #include "material.hpp"
 #include "params.hpp"
 #include "particle_set.hpp"
+#include "ranks.hpp"
 #include "reference.hpp"
 #include "scheme.hpp"
 #include "shape_function.hpp"
@@ -36,6 +37,7 @@ struct Body {
   std::string name;
   Params params;
   size_t first_id = 0, count = 0;    // particle ids [first_id, first_id + count)
+  size_t local_count = 0;            // of those, the particles this rank holds (all serially)
   std::vector<double> lower, upper;  // bounding box of the particles' domains
   std::vector<double> spacing;       // particle spacing per axis
   int set = 0;                       // index into Simulation::sets
@@ -54,6 +56,9 @@ class Simulation {
 
   Params config;
   Grid<D> grid;
+  /// The ranks the run is split over (framework/ranks.hpp): one serially, and then every call
+  /// to it is the identity. Declared after the grid, whose box it keeps (destroyed first).
+  std::unique_ptr<Ranks<D>> ranks = make_ranks<D>();
   /// The particle sets, in the order the scheme declares them; created before any plugin set-up
   /// and never added to or removed afterwards (references to them stay valid).
   std::vector<ParticleSet<D>> sets;
@@ -109,6 +114,11 @@ class Simulation {
   }
 
   // --------------------------------------------------------- hooks for schemes
+  /// Complete the nodal sums of a scatter over the ranks (Ranks::complete_nodes): a scheme calls
+  /// it after each scatter, before it reads the nodes. Serially nothing happens.
+  void complete_nodes(const std::vector<NodalArray>& arrays) {
+    if (ranks->distributed()) timed("halo", [&] { ranks->complete_nodes(arrays); });
+  }
   /// Apply every boundary condition that acts on `phase` (0: the only phase or the solid, 1: the
   /// pore water) to a nodal vector: mechanical conditions first, then hydraulic ones. Here the
   /// conditions only hold components (zeroing commutes, so the order of the config does not
@@ -331,6 +341,10 @@ class Simulation {
 
  private:
   void build_grid(const Params& g, Diagnostics& diag);
+  /// Under mpirun: refuse what does not run on ranks yet, and store this rank's box of nodes.
+  void split_over_ranks(Diagnostics& diag);
+  /// After the move under mpirun: hand the particles over to the ranks owning their cells.
+  void migrate_particles();
   void generate_bodies(Diagnostics& diag);
   void initialize_fields(Diagnostics& diag);  // bodies[].initial
   void create_plugins(Diagnostics& diag);

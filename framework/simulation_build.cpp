@@ -67,6 +67,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   create_plugins(diag);
   create_stages(diag);
   create_sets(diag);
+  split_over_ranks(diag);
   const size_t errors_before = diag.errors().size();
   generate_bodies(diag);
   const bool particles_ok = diag.errors().size() == errors_before;
@@ -201,20 +202,54 @@ void Simulation<D>::create_plugins(Diagnostics& diag) {
 }
 
 template <int D>
+void Simulation<D>::split_over_ranks(Diagnostics& diag) {
+  if (!ranks->distributed()) return;
+  // What runs on ranks so far (docs/parallel.md); everything else is refused where it is given.
+  const std::string only = " does not run under mpirun yet (docs/parallel.md lists what does)";
+  auto refuse_plugin = [&](bool runs, const Params& p) {
+    if (!runs) diag.error(p.where(), p.path(), "'" + p.type() + "'" + only);
+  };
+  if (scheme) refuse_plugin(scheme->runs_on_ranks(), config.section("scheme"));
+  if (shape) refuse_plugin(shape->runs_on_ranks(), config.section("shape_function"));
+  if (damping && config.given("damping"))
+    refuse_plugin(damping->runs_on_ranks(), config.section("damping"));
+  const auto& bp = config.list("boundaries");
+  for (size_t i = 0; i < boundaries.size() && i < bp.size(); ++i)
+    refuse_plugin(boundaries[i]->runs_on_ranks(), bp[i]);
+  const auto& lp = config.list("loads");
+  for (size_t i = 0; i < loads.size() && i < lp.size(); ++i)
+    refuse_plugin(loads[i]->runs_on_ranks(), lp[i]);
+  for (const char* key : {"sources", "sinks", "stages", "probes", "selections"})
+    if (!config.list(key).empty()) diag.error(config.where(key), key, "this key" + only);
+  for (const char* key : {"verify", "strength_reduction"})
+    if (config.given(key)) diag.error(config.where(key), key, "this key" + only);
+  if (!shape || !diag.ok()) return;
+  const std::string why = ranks->decompose(grid, shape->rows_below(), shape->rows_above(), threads);
+  if (!why.empty()) diag.error(config.section("grid").where(), "grid", why);
+}
+
+template <int D>
 void Simulation<D>::generate_bodies(Diagnostics& diag) {
   Registry& reg = Registry::instance();
   const auto& bl = config.list("bodies");
   const size_t errors_before = diag.errors().size();
+  // The particles this rank keeps (all of them serially): position, body, volume and id. Every
+  // rank walks each body's whole lattice, so that the ids (numbered over all bodies in lattice
+  // order) and the bodies' bounding boxes are those of the serial run, and keeps the points of
+  // its own cells (Ranks::owns).
   std::vector<Vec> xs;
   std::vector<uint16_t> owner;
   std::vector<double> vols;
+  std::vector<size_t> ids, first_kept;
+  size_t next_id = 0;
   for (size_t b = 0; b < bl.size(); ++b) {
+    first_kept.push_back(xs.size());
     const Params& bp = bl[b];
     if (!bp.has("generator")) {  // starts empty: its particles come from a source
       Body body;
       body.name = bp.text("name");
       body.params = bp;
-      body.first_id = xs.size();
+      body.first_id = next_id;
       body.lower.assign(D, 0.0);
       body.upper.assign(D, 0.0);
       for (int d = 0; d < D; ++d)
@@ -238,7 +273,7 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
     Body body;
     body.name = bp.text("name");
     body.params = bp;
-    body.first_id = xs.size();
+    body.first_id = next_id;
     Vec s{};
     double vol = 1;
     std::array<long, D> i0{}, i1{};
@@ -262,9 +297,13 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
       for (int d = 0; d < D; ++d)
         x[size_t(d)] = grid.origin[size_t(d)] + (double(i[size_t(d)]) + 0.5) * s[size_t(d)];
       if (gen->contains(x)) {
-        xs.push_back(x);
-        owner.push_back(uint16_t(b));
-        vols.push_back(vol);
+        if (ranks->owns(x)) {
+          xs.push_back(x);
+          owner.push_back(uint16_t(b));
+          vols.push_back(vol);
+          ids.push_back(next_id);
+        }
+        ++next_id;
         for (int d = 0; d < D; ++d) {
           plo[size_t(d)] = std::min(plo[size_t(d)], x[size_t(d)] - 0.5 * s[size_t(d)]);
           phi[size_t(d)] = std::max(phi[size_t(d)], x[size_t(d)] + 0.5 * s[size_t(d)]);
@@ -274,7 +313,8 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
       while (d < D && ++i[size_t(d)] > i1[size_t(d)]) i[size_t(d)] = i0[size_t(d)], ++d;
       if (d == D) break;
     }
-    body.count = xs.size() - body.first_id;
+    body.count = next_id - body.first_id;
+    body.local_count = xs.size() - first_kept.back();
     if (body.count == 0) {
       diag.error(bp.where("generator"), bp.path("generator"),
                  "the generator produced no particles (region smaller than the particle spacing " +
@@ -287,7 +327,7 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
     bodies.push_back(std::move(body));
   }
   if (diag.errors().size() != errors_before) return;
-  if (xs.size() > size_t(UINT32_MAX)) {
+  if (next_id > size_t(UINT32_MAX)) {
     diag.error(config.where("bodies"), "bodies", "more than 2^32 particles");
     return;
   }
@@ -297,13 +337,14 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
     Particles<D>& P = sets[si].particles;
     size_t n = 0;
     for (auto& body : bodies)
-      if (body.set == int(si)) body.first_index = n, n += body.count;
+      if (body.set == int(si)) body.first_index = n, n += body.local_count;
     P.resize(n);
-    for (const auto& body : bodies) {
+    for (size_t b = 0; b < bodies.size(); ++b) {
+      const Body& body = bodies[b];
       if (body.set != int(si)) continue;
-      for (size_t k = 0; k < body.count; ++k) {
-        const size_t i = body.first_index + k, g = body.first_id + k;
-        P.id[i] = uint32_t(g);
+      for (size_t k = 0; k < body.local_count; ++k) {
+        const size_t i = body.first_index + k, g = first_kept[b] + k;
+        P.id[i] = uint32_t(ids[g]);
         P.material[i] = owner[g];
         P.body[i] = owner[g];
         for (int d = 0; d < D; ++d) P.col(P.position, d)[i] = xs[g][size_t(d)];
@@ -323,8 +364,8 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
       if (!bp.has(key)) continue;
       auto f = reg.create<Field, D>(bp.section(key));
       const int nc = P.info(field).components;
-      for (size_t k = 0; k < bodies[b].count; ++k) {
-        f->value(xs[bodies[b].first_id + k], value.data());
+      for (size_t k = 0; k < bodies[b].local_count; ++k) {
+        f->value(xs[first_kept[b] + k], value.data());
         for (int c = 0; c < nc; ++c) P.col(field, c)[bodies[b].first_index + k] = value[size_t(c)];
       }
     }
@@ -356,7 +397,8 @@ void Simulation<D>::initialize_fields(Diagnostics& diag) {
       }
       auto f = Registry::instance().create<Field, D>(e.section("value"));
       std::array<double, D> x{};
-      for (size_t i = bodies[b].first_index; i < bodies[b].first_index + bodies[b].count; ++i) {
+      for (size_t i = bodies[b].first_index; i < bodies[b].first_index + bodies[b].local_count;
+           ++i) {
         for (int d = 0; d < D; ++d) x[size_t(d)] = particles.col(particles.position, d)[i];
         f->value(x, particles.col(h) + i);
       }

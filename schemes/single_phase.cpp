@@ -97,6 +97,9 @@ class SinglePhase : public Scheme<D> {
                      std::to_string(sim.shape->max_nodes_per_particle()));
   }
 
+  /// Every nodal sum completed over the ranks after its scatter (Simulation::complete_nodes).
+  bool runs_on_ranks() const override { return true; }
+
   std::vector<GridFieldView> grid_fields() const override {
     return {{"mass", 1, node_.data(), S, kMass},
             {"velocity", D, vel_.data(), D, 0},
@@ -142,6 +145,7 @@ class SinglePhase : public Scheme<D> {
   void step_usl_musl(Simulation<D>& sim, double dt, bool musl) {
     sim.timed("grid", [&] { zero_nodes(node_, sim.threads); });
     sim.timed("p2g", [&] { scatter_all<NPP, true, true>(sim); });
+    sim.complete_nodes({{node_.data(), S, S}});
     sim.timed("grid", [&] { update_nodes(sim, dt); });
     reset_max_speed(scratch_);
     if (musl) {
@@ -149,6 +153,7 @@ class SinglePhase : public Scheme<D> {
       // particles move with the grid velocity of the update (Sulsky 1995).
       sim.timed("grid", [&] { zero_nodes(vel_, sim.threads); });
       sim.timed("g2p_velocity_remap", [&] { update_velocities<NPP, true, false>(sim, dt); });
+      sim.complete_nodes({{vel_.data(), D, D}});
       sim.timed("grid", [&] { momentum_to_velocity(sim, vel_.data(), D, 0); });
       sim.timed("g2p_gradient_stress", [&] { update_stresses<NPP, Gradient::kRemapped>(sim, dt); });
     } else {
@@ -166,9 +171,11 @@ class SinglePhase : public Scheme<D> {
     // USF: stress from the velocity field at t^n, then forces, then the grid update.
     zero_nodes(node_, sim.threads);
     scatter_all<NPP, true, false>(sim);
+    sim.complete_nodes({{node_.data(), S, 1 + D, kMass}});
     momentum_to_velocity(sim, node_.data(), S, kMomentum);
     update_stresses<NPP, Gradient::kCurrent>(sim, dt);
     scatter_all<NPP, false, true>(sim);
+    sim.complete_nodes({{node_.data(), S, D, kForce}});
     update_nodes(sim, dt);
     reset_max_speed(scratch_);
     update_velocities<NPP, false, true>(sim, dt);

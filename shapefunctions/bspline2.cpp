@@ -47,6 +47,8 @@ class BSpline2 : public ShapeFunction<D> {
   // Nearest node b is r or r+1 for a particle in cell row r; nodes b-1 .. b+1.
   int rows_below() const override { return 1; }
   int rows_above() const override { return 2; }
+  /// Node rows fixed by the particle's cell: the ghost layer is rows_below / rows_above wide.
+  bool runs_on_ranks() const override { return true; }
 
   /// int N_i dx / h of the boundary-modified functions: the interior B-spline centred at i
   /// clipped to [0, last], plus its share of the folded ghosts (N_0 + 2 N_-1, N_1 - N_-1 and

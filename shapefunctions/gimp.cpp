@@ -80,6 +80,8 @@ class Gimp : public ShapeFunction<D> {
   // 3 nodes per axis, nodes r-1 .. r+2 with 4.
   int rows_below() const override { return 1; }
   int rows_above() const override { return 2; }
+  /// Node rows fixed by the particle's cell: the ghost layer is rows_below / rows_above wide.
+  bool runs_on_ranks() const override { return true; }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     const auto axes = Particles<D>::axis_names();

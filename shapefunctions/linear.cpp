@@ -17,6 +17,8 @@ class Linear : public ShapeFunction<D> {
   int nodes_per_particle() const override { return 1 << D; }
   int rows_below() const override { return 0; }
   int rows_above() const override { return 1; }
+  /// Node rows fixed by the particle's cell: the ghost layer is rows_below / rows_above wide.
+  bool runs_on_ranks() const override { return true; }
   bool stencil_covers_domain() const override { return false; }
 
   void evaluate(const Grid<D>& g, const Particles<D>& P, size_t begin, int count,

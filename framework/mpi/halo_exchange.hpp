@@ -15,15 +15,9 @@
 #include <vector>
 
 #include "framework/decomposition.hpp"
+#include "framework/ranks.hpp"  // NodalArray
 
 namespace loam {
-
-/// A nodal array over a rank's node box: node n's values are data[n * stride + offset + c] for
-/// c < width (e.g. a scheme's interleaved record, or one field of it).
-struct NodalArray {
-  double* data;
-  int stride, width, offset = 0;
-};
 
 template <int D>
 class HaloExchange {

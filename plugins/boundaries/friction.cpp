@@ -47,6 +47,8 @@ class Friction : public Boundary<D> {
   explicit Friction(const Params& p)
       : params_(p), face_(parse_face(p.text("face"))), mu_(p.real("coefficient")) {}
 
+  /// Per node, on the stored box (docs/parallel.md).
+  bool runs_on_ranks() const override { return true; }
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     if (!check_face(face_, D, params_, "face", diag)) return;
     nodes_ = face_nodes(sim.grid, face_);

@@ -23,6 +23,8 @@ class LocalDamping : public Damping<D> {
     return s;
   }
   explicit LocalDamping(const Params& p) : alpha_(p.real("alpha")) {}
+  /// Per node, on the stored box (docs/parallel.md).
+  bool runs_on_ranks() const override { return true; }
   void apply(Simulation<D>& sim, const NodeForces& nf) override {
     const long n = long(nf.num_nodes);
     const double tol = sim.mass_tolerance;

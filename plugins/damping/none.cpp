@@ -13,6 +13,7 @@ class NoDamping : public Damping<D> {
   static Schema schema() { return {}; }
   explicit NoDamping(const Params&) {}
   void apply(Simulation<D>&, const NodeForces&) override {}
+  bool runs_on_ranks() const override { return true; }
 };
 
 LOAM_REGISTER(Damping, NoDamping)

@@ -3,6 +3,10 @@
 // grids; the particle count may change from frame to frame). 2D/1D coordinates are padded to
 // XYZ so that ParaView glyph filters work; D-component fields are written as 3-vectors.
 // Every file is written under a temporary name and renamed when complete.
+//
+// Under mpirun (docs/parallel.md) each rank writes its own particles of a frame,
+// <set>_NNNNNN_rRRRR.h5, and the first rank the index, in which each frame is a spatial
+// collection of the ranks' pieces: ParaView opens it as one dataset per frame.
 #include <hdf5.h>
 
 #include <nlohmann/json.hpp>
@@ -68,8 +72,14 @@ class Xdmf : public Writer<D> {
           for (const auto& x : a) as.push_back({x[0], x[1], x[2]});
           return as;
         };
-        frames_[s].push_back(Frame{f["file"], f["time"], f["step"], f["n"], attrs(f["attributes"]),
-                                   f["grid_nodes"], attrs(f["grid_attributes"])});
+        frames_[s].push_back(Frame{f["file"],
+                                   f["time"],
+                                   f["step"],
+                                   f["n"],
+                                   attrs(f["attributes"]),
+                                   f["grid_nodes"],
+                                   attrs(f["grid_attributes"]),
+                                   {}});
       }
   }
 
@@ -92,6 +102,7 @@ class Xdmf : public Writer<D> {
     std::vector<Attribute> attributes;
     size_t grid_nodes = 0;
     std::vector<Attribute> grid_attributes;
+    std::vector<long> pieces;  // under mpirun, each rank's particle count (first rank only)
   };
   std::string dir_;
   std::vector<int> fields_;
@@ -103,11 +114,42 @@ class Xdmf : public Writer<D> {
   /// file, the grid), then the set's index <set>.xdmf.
   void write_set(Simulation<D>& sim, size_t s, const std::string& label) {
     const ParticleSet<D>& set = sim.sets[s];
+    const Ranks<D>& ranks = *sim.ranks;
+    char stem[128];
+    std::snprintf(stem, sizeof stem, "%s_%06ld%s", set.name.c_str(), long(frames_[s].size()),
+                  label.empty() ? "" : ("_" + label).c_str());
+    if (!ranks.distributed()) {
+      Frame fr = write_particles(sim, set, std::string(stem) + ".h5");
+      frames_[s].push_back(fr);
+      write_index(set.name, frames_[s], with_grid_ && s == 0);
+      return;
+    }
+    // Every rank takes part in the gather even if its file failed, so that none waits forever;
+    // the failure is reported after it (the runner stops all ranks).
+    Frame fr;
+    std::string error, failed_file;
+    try {
+      fr = write_particles(sim, set, std::string(stem) + piece_suffix(ranks.rank()));
+    } catch (const WriteError& e) {
+      error = e.what(), failed_file = e.file;
+    }
+    fr.file = stem;
+    fr.pieces = ranks.gather(long(set.size()));
+    if (!error.empty()) throw WriteError(failed_file, error);
+    frames_[s].push_back(fr);
+    if (ranks.root()) write_index(set.name, frames_[s], false);
+  }
+
+  static std::string piece_suffix(int rank) {
+    char s[32];
+    std::snprintf(s, sizeof s, "_r%04d.h5", rank);
+    return s;
+  }
+
+  /// This process's particles of a set as the HDF5 file `name` in the directory.
+  Frame write_particles(Simulation<D>& sim, const ParticleSet<D>& set, const std::string& name) {
     const Particles<D>& P = set.particles;
     const size_t n = P.size();
-    char name[128];
-    std::snprintf(name, sizeof name, "%s_%06ld%s.h5", set.name.c_str(), long(frames_[s].size()),
-                  label.empty() ? "" : ("_" + label).c_str());
     std::filesystem::path file = std::filesystem::path(dir_) / name;
     std::filesystem::path tmp = file;
     tmp += ".tmp";
@@ -116,7 +158,7 @@ class Xdmf : public Writer<D> {
     hid_t f = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     if (f < 0) fail(file, tmp);
     ok_ = true;
-    Frame fr{name, sim.time, sim.step, n, {}, 0, {}};
+    Frame fr{name, sim.time, sim.step, n, {}, 0, {}, {}};
     write_columns(f, "position", P, P.position, 3);
     std::vector<int> ids(n);
     for (size_t i = 0; i < n; ++i) ids[i] = int(P.id[i]);
@@ -133,13 +175,11 @@ class Xdmf : public Writer<D> {
       write_columns(f, info.name, P, h, width);
       fr.attributes.push_back({info.name, width, "Float"});
     }
-    const bool grid = with_grid_ && s == 0;
-    if (grid) write_grid(f, sim, fr);
+    if (with_grid_ && &set == &sim.sets[0]) write_grid(f, sim, fr);
     const bool closed = H5Fclose(f) >= 0;
     if (!ok_ || !closed) fail(file, tmp);
     std::filesystem::rename(tmp, file);
-    frames_[s].push_back(fr);
-    write_index(set.name, frames_[s], grid);
+    return fr;
   }
 
   /// The frame's temporary file is removed and the failure reported (WriteError).
@@ -195,12 +235,14 @@ class Xdmf : public Writer<D> {
     return width == 1 ? "Scalar" : width == 3 ? "Vector" : width == 6 ? "Tensor6" : "Matrix";
   }
 
+  /// A Uniform grid of n points in `file`; with a time unless it is a piece of a spatial
+  /// collection (which carries the time).
   static void polyvertex(std::ostream& x, const std::string& grid_name, const std::string& file,
                          const std::string& prefix, size_t n, const std::vector<Attribute>& attrs,
-                         double time) {
-    x << "      <Grid Name=\"" << grid_name << "\" GridType=\"Uniform\">\n"
-      << "        <Time Value=\"" << time << "\"/>\n"
-      << "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n << "\"/>\n"
+                         double time, bool piece = false) {
+    x << "      <Grid Name=\"" << grid_name << "\" GridType=\"Uniform\">\n";
+    if (!piece) x << "        <Time Value=\"" << time << "\"/>\n";
+    x << "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n << "\"/>\n"
       << "        <Geometry GeometryType=\"XYZ\"><DataItem Dimensions=\"" << n
       << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << file << ":/" << prefix
       << "position</DataItem></Geometry>\n";
@@ -220,7 +262,20 @@ class Xdmf : public Writer<D> {
     x.precision(12);
     x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n"
       << "    <Grid Name=\"" << set << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-    for (const auto& fr : frames) polyvertex(x, set, fr.file, "", fr.n, fr.attributes, fr.time);
+    for (const auto& fr : frames) {
+      if (fr.pieces.empty()) {
+        polyvertex(x, set, fr.file, "", fr.n, fr.attributes, fr.time);
+        continue;
+      }
+      // One frame under mpirun: the ranks' pieces (a rank without particles has none).
+      x << "      <Grid Name=\"" << set << "\" GridType=\"Collection\" "
+        << "CollectionType=\"Spatial\">\n        <Time Value=\"" << fr.time << "\"/>\n";
+      for (size_t r = 0; r < fr.pieces.size(); ++r)
+        if (fr.pieces[r] > 0)
+          polyvertex(x, set + piece_suffix(int(r)).substr(0, 6), fr.file + piece_suffix(int(r)), "",
+                     size_t(fr.pieces[r]), fr.attributes, fr.time, true);
+      x << "      </Grid>\n";
+    }
     x << "    </Grid>\n";
     if (grid) {
       x << "    <Grid Name=\"grid\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";

@@ -1,0 +1,130 @@
+#include "mpi_ranks.hpp"
+
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
+#include "mpi_error.hpp"
+
+namespace loam {
+
+template <int D>
+std::string MpiRanks<D>::decompose(Grid<D>& grid, int rows_below, int rows_above, int threads) {
+  try {
+    decomposition_ = std::make_unique<Decomposition<D>>(grid, cart_.dims(), cart_.coords(),
+                                                        rows_below, rows_above);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  const NodeBox<D>& box = decomposition_->box();
+  grid.store_nodes(box.lo, box.hi);
+  grid_ = &grid;
+  halo_ = std::make_unique<HaloExchange<D>>(cart_.comm(), *decomposition_, threads);
+  migration_ = std::make_unique<ParticleMigration<D>>(cart_.comm(), *decomposition_, grid);
+  return "";
+}
+
+template <int D>
+bool MpiRanks<D>::owns(const std::array<double, D>& x) const {
+  if (!decomposition_) return true;  // not split (the model has errors): checked as a whole
+  std::array<int, D> cell{};
+  for (int d = 0; d < D; ++d) cell[size_t(d)] = grid_->cell_of(x[size_t(d)], d);
+  return decomposition_->owns_cell(cell);
+}
+
+template <int D>
+void MpiRanks<D>::complete_nodes(const std::vector<NodalArray>& arrays) {
+  halo_->reverse(arrays);
+  halo_->forward(arrays);
+}
+
+template <int D>
+bool MpiRanks<D>::migrate(Particles<D>& P, long& strays, long& first_stray) {
+  const long sent = migration_->particles_sent();
+  const size_t before = P.size();
+  strays = migration_->migrate(P);
+  first_stray = migration_->first_stray();
+  return migration_->particles_sent() != sent || P.size() != before;
+}
+
+template <int D>
+double MpiRanks<D>::min(double v) const {
+  double r = v;
+  mpi_check(MPI_Allreduce(&v, &r, 1, MPI_DOUBLE, MPI_MIN, cart_.comm()), "MPI_Allreduce");
+  return r;
+}
+
+template <int D>
+double MpiRanks<D>::max(double v) const {
+  double r = v;
+  mpi_check(MPI_Allreduce(&v, &r, 1, MPI_DOUBLE, MPI_MAX, cart_.comm()), "MPI_Allreduce");
+  return r;
+}
+
+template <int D>
+int MpiRanks<D>::max(int v) const {
+  int r = v;
+  mpi_check(MPI_Allreduce(&v, &r, 1, MPI_INT, MPI_MAX, cart_.comm()), "MPI_Allreduce");
+  return r;
+}
+
+template <int D>
+void MpiRanks<D>::sum(double* values, int n) const {
+  if (n > 0)
+    mpi_check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_DOUBLE, MPI_SUM, cart_.comm()),
+              "MPI_Allreduce");
+}
+
+template <int D>
+std::string MpiRanks<D>::first_message(const std::string& mine) const {
+  const int me = mine.empty() ? cart_.size() : cart_.rank();
+  int first = me;
+  mpi_check(MPI_Allreduce(&me, &first, 1, MPI_INT, MPI_MIN, cart_.comm()), "MPI_Allreduce");
+  if (first == cart_.size()) return "";
+  int length = int(mine.size());
+  mpi_check(MPI_Bcast(&length, 1, MPI_INT, first, cart_.comm()), "MPI_Bcast");
+  std::string text = cart_.rank() == first ? mine : std::string(size_t(length), ' ');
+  mpi_check(MPI_Bcast(text.data(), length, MPI_CHAR, first, cart_.comm()), "MPI_Bcast");
+  return text;
+}
+
+template <int D>
+std::vector<long> MpiRanks<D>::gather(long n) const {
+  std::vector<long> all(cart_.rank() == 0 ? size_t(cart_.size()) : 0);
+  mpi_check(MPI_Gather(&n, 1, MPI_LONG, all.data(), 1, MPI_LONG, 0, cart_.comm()), "MPI_Gather");
+  return all;
+}
+
+template <int D>
+void MpiRanks<D>::barrier() const {
+  mpi_check(MPI_Barrier(cart_.comm()), "MPI_Barrier");
+}
+
+template class MpiRanks<1>;
+template class MpiRanks<2>;
+template class MpiRanks<3>;
+
+void mpi_abort(int code) {
+  MPI_Abort(MPI_COMM_WORLD, code);
+  std::exit(code);
+}
+
+MpiSession::MpiSession(int& argc, char**& argv) {
+  int provided = 0;
+  mpi_check(MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+  if (provided < MPI_THREAD_FUNNELED)
+    throw std::runtime_error("the MPI library does not provide MPI_THREAD_FUNNELED");
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  RanksFactory& f = ranks_factory();
+  f.d1 = [] { return std::make_unique<MpiRanks<1>>(MPI_COMM_WORLD); };
+  f.d2 = [] { return std::make_unique<MpiRanks<2>>(MPI_COMM_WORLD); };
+  f.d3 = [] { return std::make_unique<MpiRanks<3>>(MPI_COMM_WORLD); };
+}
+
+MpiSession::~MpiSession() {
+  ranks_factory() = RanksFactory{};
+  MPI_Finalize();
+}
+
+}  // namespace loam

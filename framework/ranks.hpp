@@ -1,0 +1,98 @@
+#pragma once
+// The ranks a run is split over (docs/parallel.md). A run on one process has one rank, and every
+// operation here is then the identity: the serial code path does exactly what it did before.
+// Under `mpirun`, the MPI build's MpiRanks (framework/mpi/mpi_ranks.hpp) splits the grid into
+// Cartesian blocks: each rank keeps the particles of its cells and a box of nodes (its own and
+// a ghost layer as wide as the shape function's reach), completes its nodal sums with the
+// neighbouring blocks after every scatter, hands particles over after the move, and reduces the
+// step's scalars (time step, energies, failures) over all ranks. The core and the schemes call
+// only this interface; the MPI code lives in libloam_mpi.
+#include <array>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "grid.hpp"
+#include "particles.hpp"
+
+namespace loam {
+
+/// A nodal array as the exchanges see it: node n's `width` values start at
+/// data[n * stride + offset] (a scheme's interleaved record, or one field of it).
+struct NodalArray {
+  double* data;
+  int stride, width, offset = 0;
+};
+
+template <int D>
+class Ranks {
+ public:
+  virtual ~Ranks() = default;
+  /// Whether the run is split by a parallel launcher (mpirun), also at one rank: then the
+  /// features that do not run on ranks yet are refused (Simulation's build).
+  virtual bool distributed() const { return false; }
+  virtual int rank() const { return 0; }
+  virtual int size() const { return 1; }
+  bool root() const { return rank() == 0; }
+
+  /// Split the grid: this rank's box of nodes is stored in `grid` (Grid::store_nodes), which
+  /// must outlive the ranks; `threads` pack and unpack the messages. Returns "" or why the grid
+  /// cannot be split over these ranks (a block thinner than the shape function's reach).
+  virtual std::string decompose(Grid<D>& /*grid*/, int /*rows_below*/, int /*rows_above*/,
+                                int /*threads*/) {
+    return "";
+  }
+  /// Whether this rank owns the cell of point x (its particles are generated and kept here).
+  virtual bool owns(const std::array<double, D>& /*x*/) const { return true; }
+
+  /// Complete nodal sums over the ranks after a scatter: each ghost node's share is added into
+  /// its owner (in a fixed neighbour order), and the owner's total copied back to every ghost
+  /// copy, so that every stored node holds the whole grid's value (a reverse and a forward halo
+  /// exchange, each one packed message per neighbour).
+  virtual void complete_nodes(const std::vector<NodalArray>& /*arrays*/) {}
+  /// Send the particles of P whose cell another rank owns to it, append those that arrive.
+  /// Returns whether P changed (a particle left or arrived). `strays` counts the particles that
+  /// moved beyond the neighbouring blocks (kept here; `first_stray` is the first one's id).
+  virtual bool migrate(Particles<D>& /*P*/, long& strays, long& first_stray) {
+    strays = 0;
+    first_stray = -1;
+    return false;
+  }
+
+  /// Reductions over all ranks (every rank calls them, in the same order).
+  virtual double min(double v) const { return v; }
+  virtual double max(double v) const { return v; }
+  virtual void sum(double* /*values*/, int /*n*/) const {}
+  virtual int max(int v) const { return v; }
+  /// The message of the lowest rank whose message is not empty, on every rank ("" if none):
+  /// a failure one rank finds stops every rank, with the same words.
+  virtual std::string first_message(const std::string& mine) const { return mine; }
+  /// Every rank's n, on rank 0 in rank order (empty on the others).
+  virtual std::vector<long> gather(long n) const { return {n}; }
+  virtual void barrier() const {}
+};
+
+/// Makes the ranks of a run of dimension D. Empty (the default): the serial Ranks. The MPI
+/// build's main sets these when the process was started by mpirun.
+struct RanksFactory {
+  std::function<std::unique_ptr<Ranks<1>>()> d1;
+  std::function<std::unique_ptr<Ranks<2>>()> d2;
+  std::function<std::unique_ptr<Ranks<3>>()> d3;
+};
+RanksFactory& ranks_factory();
+
+template <int D>
+std::unique_ptr<Ranks<D>> make_ranks() {
+  const RanksFactory& f = ranks_factory();
+  if constexpr (D == 1) {
+    if (f.d1) return f.d1();
+  } else if constexpr (D == 2) {
+    if (f.d2) return f.d2();
+  } else {
+    if (f.d3) return f.d3();
+  }
+  return std::make_unique<Ranks<D>>();
+}
+
+}  // namespace loam
