@@ -207,6 +207,42 @@ class Decomposition {
     return blocks;
   }
 
+  /// Links for sums over grid cells (a scheme's per-cell means after the move): this block's
+  /// cells and a ghost layer of one cell around them (a particle moves less than a cell per
+  /// step, so before migration it is in an owned or a ghost cell). Per adjacent block, `ghosts`
+  /// are the ghost cells it owns and `shared` the owned cells in its ghost layer, as global
+  /// cell indices (`cell_stride`: the grid's), both walked in the same order on both sides.
+  std::vector<Neighbour> cell_links(const std::array<long, D>& cell_stride) const {
+    auto cells = [&](const std::array<int, D>& c, int layer) {
+      NodeBox<D> b;
+      for (int d = 0; d < D; ++d) {
+        const auto [lo, hi] = cells_of(c, d);
+        b.lo[d] = std::max(0, lo - layer);
+        b.hi[d] = std::min(cells_[d], hi + layer);
+      }
+      return b;
+    };
+    auto index = [&](const std::array<int, D>& ijk) {
+      size_t i = 0;
+      for (int d = 0; d < D; ++d) i += size_t(ijk[d]) * size_t(cell_stride[d]);
+      return i;
+    };
+    std::vector<Neighbour> links;
+    for (const auto& a : adjacent_blocks()) {
+      Neighbour n;
+      n.offset = a.offset;
+      n.coords = a.coords;
+      cells(coords_, 1).intersect(cells(a.coords, 0)).for_each([&](const auto& ijk) {
+        n.ghosts.push_back(index(ijk));
+      });
+      cells(coords_, 0).intersect(cells(a.coords, 1)).for_each([&](const auto& ijk) {
+        n.shared.push_back(index(ijk));
+      });
+      if (!n.ghosts.empty() || !n.shared.empty()) links.push_back(std::move(n));
+    }
+    return links;
+  }
+
  private:
   std::array<int, D> dims_, coords_, cells_{};
   int below_, above_;

@@ -51,6 +51,11 @@ class Ranks {
   /// copy, so that every stored node holds the whole grid's value (a reverse and a forward halo
   /// exchange, each one packed message per neighbour).
   virtual void complete_nodes(const std::vector<NodalArray>& /*arrays*/) {}
+  /// Complete sums over grid cells (K values per cell, global cell index) after the move and
+  /// before migration: a particle is then in an owned cell or in the ghost layer of one cell
+  /// around the block. The ghost cells' shares are added into their owners and the totals
+  /// copied back, so every cell a particle of this rank is in holds the whole model's sum.
+  virtual void complete_cells(double* /*sums*/, int /*K*/) {}
   /// Send the particles of P whose cell another rank owns to it, append those that arrive.
   /// Returns whether P changed (a particle left or arrived). `strays` counts the particles that
   /// moved beyond the neighbouring blocks (kept here; `first_stray` is the first one's id).
@@ -70,6 +75,8 @@ class Ranks {
   virtual std::string first_message(const std::string& mine) const { return mine; }
   /// Every rank's n, on rank 0 in rank order (empty on the others).
   virtual std::vector<long> gather(long n) const { return {n}; }
+  /// Every rank's values, concatenated in rank order, on every rank.
+  virtual std::vector<double> all_gather(const std::vector<double>& mine) const { return mine; }
   virtual void barrier() const {}
 };
 

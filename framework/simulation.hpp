@@ -119,6 +119,11 @@ class Simulation {
   void complete_nodes(const std::vector<NodalArray>& arrays) {
     if (ranks->distributed()) timed("halo", [&] { ranks->complete_nodes(arrays); });
   }
+  /// Complete per-cell sums (K values per grid cell) over the ranks (Ranks::complete_cells): a
+  /// scheme calls it after summing its particles per cell after the move. Serially nothing.
+  void complete_cells(std::vector<double>& sums, int K) {
+    if (ranks->distributed()) timed("halo", [&] { ranks->complete_cells(sums.data(), K); });
+  }
   /// Apply every boundary condition that acts on `phase` (0: the only phase or the solid, 1: the
   /// pore water) to a nodal vector: mechanical conditions first, then hydraulic ones. Here the
   /// conditions only hold components (zeroing commutes, so the order of the config does not

@@ -195,6 +195,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     }
   }
 
+  /// Both nodal records completed over the ranks after their scatters, and the cell sums of the
+  /// pressure smoothing after the move.
+  bool runs_on_ranks() const override { return true; }
+
   std::vector<GridFieldView> grid_fields() const override {
     return {{"mass", 1, node_.data(), S, 0},
             {"velocity", D, node_.data(), S, kV},
@@ -218,6 +222,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       sim.scatter_blocks(
           [&](ParticleSet<D>& s, size_t b, int c, int t) { scatter<NPP>(sim, s, b, c, t); });
     });
+    sim.complete_nodes({{node_.data(), S, S}});
     sim.timed("grid", [&] { integrate(sim, dt); });
     reset_max_speed(scratch_);
     if (musl_) {
@@ -226,6 +231,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         sim.scatter_blocks(
             [&](ParticleSet<D>& s, size_t b, int c, int t) { remap<NPP>(sim, s, dt, b, c, t); });
       });
+      sim.complete_nodes({{remap_.data(), 2 * D, 2 * D}});
       sim.timed("grid", [&] { remapped_velocities(sim); });
     }
     sim.timed("g2p_gradient_stress", [&] {
@@ -312,6 +318,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       v[0] = V[i] * (p[i] + dp_[i]);
       v[1] = V[i];
     });
+    sim.complete_cells(cell_, 2);  // a cell's particles may be on two ranks before migration
 #pragma omp parallel for schedule(static) num_threads(sim.threads)
     for (long i = 0; i < np; ++i) {
       const size_t c = cell_index_[size_t(i)];

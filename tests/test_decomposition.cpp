@@ -198,3 +198,75 @@ TEST_CASE("decomposition: shape functions on a block's node box give the whole g
     check_box_evaluation<3>(shape, {2, 2, 2});
   }
 }
+
+namespace {
+
+/// Cell links (Decomposition::cell_links) of every block of a rank array: what a block sends
+/// to a neighbour is, cell for cell and in order, what the neighbour expects back, every ghost
+/// cell belongs to the neighbour it is sent to, and the ghost cells of a block are exactly the
+/// cells within one cell of it outside it, each in one link.
+template <int D>
+void check_cell_links(const std::vector<std::array<int, D>>& arrays) {
+  auto sim = loam_test::decomposition_scene<D>("linear");
+  const auto& g = sim->grid;
+  for (const auto& dims : arrays) {
+    long mismatched = 0, links = 0, ghost_errors = 0;
+    for (const auto& c : every_block<D>(dims)) {
+      const Decomposition<D> dec(g, dims, c, 0, 1);
+      const auto mine = dec.cell_links(g.cell_stride);
+      std::map<size_t, int> ghost_count;
+      for (const auto& n : mine) {
+        ++links;
+        const Decomposition<D> other(g, dims, n.coords, 0, 1);
+        const auto back_links = other.cell_links(g.cell_stride);
+        const typename Decomposition<D>::Neighbour* back = nullptr;
+        for (const auto& m : back_links)
+          if (m.coords == c) back = &m;
+        if (!back || back->shared != n.ghosts || back->ghosts != n.shared) ++mismatched;
+        for (size_t cell : n.ghosts) {
+          ++ghost_count[cell];
+          std::array<int, D> ijk{};
+          for (int d = D - 1; d >= 0; --d) {
+            ijk[size_t(d)] = int(cell / size_t(g.cell_stride[size_t(d)]));
+            cell %= size_t(g.cell_stride[size_t(d)]);
+          }
+          ghost_errors += !other.owns_cell(ijk);
+        }
+      }
+      // The ring of cells around the block, inside the grid.
+      long ring = 0;
+      loam::NodeBox<D> all;
+      for (int d = 0; d < D; ++d) all.hi[d] = g.cells[d];
+      all.for_each([&](const std::array<int, D>& ijk) {
+        if (dec.owns_cell(ijk)) return;
+        bool near = true;
+        for (int d = 0; d < D; ++d) {
+          const auto [lo, hi] = dec.cells_of(c, d);
+          near = near && ijk[size_t(d)] >= lo - 1 && ijk[size_t(d)] <= hi;
+        }
+        if (!near) return;
+        ++ring;
+        size_t i = 0;
+        for (int d = 0; d < D; ++d) i += size_t(ijk[size_t(d)]) * size_t(g.cell_stride[size_t(d)]);
+        ghost_errors += ghost_count.count(i) == 0 || ghost_count[i] != 1;
+      });
+      ghost_errors += long(ghost_count.size()) != ring;
+    }
+    INFO(D << "D, " << links << " cell links");
+    std::printf("%dD cell links of %d-block arrays: %ld links, %ld mismatched, %ld ghost errors\n",
+                D, int(every_block<D>(dims).size()), links, mismatched, ghost_errors);
+    CHECK(mismatched == 0);
+    CHECK(ghost_errors == 0);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("decomposition: cell links cover the ring of cells around each block and match",
+          "[decomposition][mpi]") {
+  // The per-cell sums of a scheme (pressure smoothing of the two-phase scheme) are completed
+  // over these links after the move (docs/parallel.md).
+  check_cell_links<1>({{2}, {3}, {7}});
+  check_cell_links<2>({{2, 1}, {2, 2}, {3, 2}, {4, 5}});
+  check_cell_links<3>({{2, 2, 1}, {2, 2, 2}, {3, 2, 2}});
+}

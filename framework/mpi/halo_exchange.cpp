@@ -47,8 +47,14 @@ void unpack(const std::vector<NodalArray>& arrays, const std::vector<size_t>& no
 
 template <int D>
 HaloExchange<D>::HaloExchange(MPI_Comm comm, const Decomposition<D>& decomposition, int threads)
+    : HaloExchange(comm, decomposition.neighbours(), threads) {}
+
+template <int D>
+HaloExchange<D>::HaloExchange(MPI_Comm comm,
+                              const std::vector<typename Decomposition<D>::Neighbour>& links,
+                              int threads)
     : comm_(comm), threads_(threads) {
-  for (const auto& n : decomposition.neighbours()) {
+  for (const auto& n : links) {
     Link l;
     mpi_check(MPI_Cart_rank(comm, n.coords.data(), &l.rank), "MPI_Cart_rank");
     l.send_tag = direction_tag<D>(n.offset, 1);   // this rank -> neighbour: travelling by +offset

@@ -25,6 +25,10 @@ class HaloExchange {
   /// `comm`: the Cartesian communicator whose rank coordinates `decomposition` was built for;
   /// `decomposition` must outlive the exchange (its links hold the node lists).
   HaloExchange(MPI_Comm comm, const Decomposition<D>& decomposition, int threads = 1);
+  /// The same over other links, e.g. Decomposition::cell_links for sums over cells (the arrays
+  /// are then indexed by global cell); `links` must outlive the exchange.
+  HaloExchange(MPI_Comm comm, const std::vector<typename Decomposition<D>::Neighbour>& links,
+               int threads = 1);
 
   /// Ghost values added to their owners' (ghosts keep theirs; a forward exchange refreshes them).
   void reverse(const std::vector<NodalArray>& arrays);

@@ -20,6 +20,8 @@ std::string MpiRanks<D>::decompose(Grid<D>& grid, int rows_below, int rows_above
   grid.store_nodes(box.lo, box.hi);
   grid_ = &grid;
   halo_ = std::make_unique<HaloExchange<D>>(cart_.comm(), *decomposition_, threads);
+  cell_links_ = decomposition_->cell_links(grid.cell_stride);
+  cell_halo_ = std::make_unique<HaloExchange<D>>(cart_.comm(), cell_links_, threads);
   migration_ = std::make_unique<ParticleMigration<D>>(cart_.comm(), *decomposition_, grid);
   return "";
 }
@@ -36,6 +38,12 @@ template <int D>
 void MpiRanks<D>::complete_nodes(const std::vector<NodalArray>& arrays) {
   halo_->reverse(arrays);
   halo_->forward(arrays);
+}
+
+template <int D>
+void MpiRanks<D>::complete_cells(double* sums, int K) {
+  cell_halo_->reverse({{sums, K, K}});
+  cell_halo_->forward({{sums, K, K}});
 }
 
 template <int D>
@@ -92,6 +100,20 @@ template <int D>
 std::vector<long> MpiRanks<D>::gather(long n) const {
   std::vector<long> all(cart_.rank() == 0 ? size_t(cart_.size()) : 0);
   mpi_check(MPI_Gather(&n, 1, MPI_LONG, all.data(), 1, MPI_LONG, 0, cart_.comm()), "MPI_Gather");
+  return all;
+}
+
+template <int D>
+std::vector<double> MpiRanks<D>::all_gather(const std::vector<double>& mine) const {
+  const int n = int(mine.size());
+  std::vector<int> counts(size_t(cart_.size())), offsets(size_t(cart_.size()), 0);
+  mpi_check(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, cart_.comm()),
+            "MPI_Allgather");
+  for (size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<double> all(size_t(offsets.back() + counts.back()));
+  mpi_check(MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
+                           MPI_DOUBLE, cart_.comm()),
+            "MPI_Allgatherv");
   return all;
 }
 

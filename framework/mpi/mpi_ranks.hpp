@@ -31,6 +31,7 @@ class MpiRanks : public Ranks<D> {
   std::string decompose(Grid<D>& grid, int rows_below, int rows_above, int threads) override;
   bool owns(const std::array<double, D>& x) const override;
   void complete_nodes(const std::vector<NodalArray>& arrays) override;
+  void complete_cells(double* sums, int K) override;
   bool migrate(Particles<D>& P, long& strays, long& first_stray) override;
 
   double min(double v) const override;
@@ -39,6 +40,7 @@ class MpiRanks : public Ranks<D> {
   void sum(double* values, int n) const override;
   std::string first_message(const std::string& mine) const override;
   std::vector<long> gather(long n) const override;
+  std::vector<double> all_gather(const std::vector<double>& mine) const override;
   void barrier() const override;
 
  private:
@@ -46,6 +48,8 @@ class MpiRanks : public Ranks<D> {
   const Grid<D>* grid_ = nullptr;
   std::unique_ptr<Decomposition<D>> decomposition_;
   std::unique_ptr<HaloExchange<D>> halo_;
+  std::vector<typename Decomposition<D>::Neighbour> cell_links_;
+  std::unique_ptr<HaloExchange<D>> cell_halo_;
   std::unique_ptr<ParticleMigration<D>> migration_;
 };
 

@@ -21,6 +21,8 @@ class Drained : public HydraulicFace<D> {
   }
   explicit Drained(const Params& p) : HydraulicFace<D>(p) {}
   const char* condition() const override { return name; }
+  /// Per node of the face, on the stored box (docs/parallel.md).
+  bool runs_on_ranks() const override { return true; }
   int releases_face() const override { return face_index(this->face_); }
   void before_constraints(const GridUpdate& u) override { this->record(u); }
   void constrain_grid_update(const GridUpdate& u) const override { this->release(u); }

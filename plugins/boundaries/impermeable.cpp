@@ -22,6 +22,8 @@ class Impermeable : public HydraulicFace<D> {
   }
   explicit Impermeable(const Params& p) : HydraulicFace<D>(p) {}
   const char* condition() const override { return name; }
+  /// Per node of the face, on the stored box (docs/parallel.md).
+  bool runs_on_ranks() const override { return true; }
   /// Also called for the solid (phase 0), to read its constrained velocity on the face.
   bool applies_to(int) const override { return true; }
   /// MUSL re-mapped velocities come one phase at a time, solid first: keep the solid's normal

@@ -69,6 +69,11 @@ class Traction : public Load<D> {
     for (int d = 0; d < D; ++d) t_[size_t(d)] = p.vec("traction")[size_t(d)];
   }
   bool uses_particle_forces() const override { return !surface_; }
+  /// Applied as particle forces (scattered before the nodal sums are completed), each rank
+  /// holding every loaded particle's id and area, so a particle that changes rank keeps its
+  /// load. At the surface, not yet: the grid load of a particle would reach the nodes of its
+  /// rank only.
+  bool runs_on_ranks() const override { return !surface_; }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     if (!check_face(face_, D, params_, "face", diag)) return;
@@ -93,8 +98,6 @@ class Traction : public Load<D> {
         if (P.body[i] == b && std::fabs(P.col(P.position, face_.axis)[i] - plane) < half * 1.001)
           ids_.push_back(P.id[i]);
     }
-    if (ids_.empty())
-      diag.error(params_.where(), params_.path(), "the traction selects no particles");
     if (params_.has("selection")) check_one_layer(sim, diag);
     area_.resize(ids_.size());
     length_.resize(ids_.size());
@@ -105,6 +108,9 @@ class Traction : public Load<D> {
       length_[k] = sim.bodies[P.body[i]].spacing[size_t(face_.axis)];
       area_[k] = P.col(P.volume)[i] / length_[k];
     }
+    gather_over_ranks(*sim.ranks);
+    if (ids_.empty())
+      diag.error(params_.where(), params_.path(), "the traction selects no particles");
     if (surface_) {
       if (!sim.shape->stencil_covers_domain())
         diag.error(params_.where("apply_at"), params_.path("apply_at"),
@@ -164,6 +170,22 @@ class Traction : public Load<D> {
   }
 
  private:
+  /// Under mpirun: every rank's loaded particles (id, area, length) on every rank, in rank
+  /// order (docs/parallel.md).
+  void gather_over_ranks(const Ranks<D>& ranks) {
+    if (!ranks.distributed()) return;
+    std::vector<double> mine;
+    for (size_t k = 0; k < ids_.size(); ++k)
+      mine.insert(mine.end(), {double(ids_[k]), area_[k], length_[k]});
+    const std::vector<double> all = ranks.all_gather(mine);
+    ids_.clear(), area_.clear(), length_.clear();
+    for (size_t k = 0; k + 2 < all.size(); k += 3) {
+      ids_.push_back(uint32_t(all[k]));
+      area_.push_back(all[k + 1]);
+      length_.push_back(all[k + 2]);
+    }
+  }
+
   /// Each selected particle carries t A_p: a selection two particles deep along the face normal
   /// would carry the traction twice. Particles on one line normal to the face share their
   /// tangential lattice cell (floor(x / spacing) on every other axis, at set-up).
