@@ -713,16 +713,16 @@ RunResult Run<D>::loop() {
   if (sim.profiling) res.summary["profile_seconds"] = sim.profile;
   Energies e1 = sim.energies();
   // Sources and sinks: counts and the mass balance (round-off when nothing is lost).
-  double mass_now = sim.total_mass();
-  if (distributed) sim.ranks->sum(&mass_now, 1);
+  double mass_now = sim.total_mass(), mass_initial = sim.initial_mass;
+  if (distributed) sim.ranks->sum(&mass_now, 1), sim.ranks->sum(&mass_initial, 1);
   res.summary["particles_created"] = sim.created;
   res.summary["particles_removed"] = sim.removed;
   res.summary["mass"] = {
-      {"initial", sim.initial_mass},
+      {"initial", mass_initial},
       {"final", mass_now},
       {"created", sim.mass_created},
       {"removed", sim.mass_removed},
-      {"balance", mass_now + sim.mass_removed - sim.mass_created - sim.initial_mass}};
+      {"balance", mass_now + sim.mass_removed - sim.mass_created - mass_initial}};
   res.summary["energy_initial"] = energy_json(ls_.e0);
   res.summary["energy_final"] = energy_json(e1);
   res.summary["verify"] = nlohmann::json::object();  // always there: empty without a reference

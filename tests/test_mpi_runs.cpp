@@ -21,14 +21,15 @@ using loam_test::TempDir;
 
 /// `loam run` of dir/run.yaml into dir/<out>: serially (ranks 0) or under mpirun -np ranks.
 /// OpenMPI as root (CI) needs the two ALLOW_RUN_AS_ROOT variables, 4 ranks on 2 cores
-/// --oversubscribe; containers may forbid cross-memory attach (single_copy_mechanism).
+/// --oversubscribe; containers may forbid cross-memory attach (single_copy_mechanism); a rank
+/// waiting in MPI yields its core (yield_when_idle: ctest runs other tests beside it).
 loam_test::CliResult run_on(const fs::path& dir, const std::string& out, int ranks,
                             const std::string& args = "") {
   std::string launch;
   if (ranks > 0)
     launch =
         "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
-        "OMPI_MCA_btl_vader_single_copy_mechanism=none " +
+        "OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_mpi_yield_when_idle=1 " +
         std::string(LOAM_MPIEXEC) + " -np " + std::to_string(ranks) + " --oversubscribe ";
   return loam_test::run_command(launch + LOAM_EXE + " run " + (dir / "run.yaml").string() +
                                 " --quiet --threads 1 --out " + (dir / out).string() + " " + args);
@@ -304,6 +305,16 @@ TEST_CASE("mpirun -np 1, 2 and 4: whole runs match the serial run, every shape f
       }
       const double field_error = difference.relative();
       const bool ids_match = difference.ids_match;
+      // summary.json: the whole model's counts and masses, written by the first rank.
+      const auto summary = nlohmann::json::parse(loam_test::slurp(dir.path / out / "summary.json"));
+      const auto summary0 =
+          nlohmann::json::parse(loam_test::slurp(dir.path / "serial" / "summary.json"));
+      CHECK(summary["particles"] == summary0["particles"]);
+      CHECK(summary["ranks"] == ranks);
+      for (const char* key : {"initial", "final"})
+        CHECK(std::fabs(summary["mass"][key].get<double>() - mass) <= 1e-12 * mass);
+      CHECK(std::fabs(summary["energy_final"]["kinetic"].get<double>() -
+                      summary0["energy_final"]["kinetic"].get<double>()) <= 1e-12 * energy_scale);
       const long last = frame_ids.back();
       const bool same_bits = frames_identical(read_frame(dir.path / "serial", last, 0),
                                               read_frame(dir.path / out, last, ranks));
