@@ -396,7 +396,8 @@ nlohmann::json Run<D>::base_summary() const {
   s["config_file"] = cfg_.file;
   s["config"] = cfg_.params.to_json();
   s["dimension"] = D;
-  s["particles"] = global_particles();
+  const double particles = global_particles();
+  s["particles"] = size_t(particles);
   nlohmann::json sets = nlohmann::json::object();
   for (const auto& set : sim_->sets) {
     std::vector<std::string> bodies;
@@ -424,7 +425,6 @@ nlohmann::json Run<D>::base_summary() const {
   for (const auto& set : sim_->sets)
     bytes += double(set.size()) * double(set.particles.bytes_per_particle());
   sim_->ranks->sum(&bytes, 1);
-  const double particles = global_particles();
   s["bytes_per_particle"] =
       particles > 0 ? size_t(bytes / particles) : sim_->sets[0].particles.bytes_per_particle();
   return s;
@@ -713,8 +713,9 @@ RunResult Run<D>::loop() {
   if (sim.profiling) res.summary["profile_seconds"] = sim.profile;
   Energies e1 = sim.energies();
   // Sources and sinks: counts and the mass balance (round-off when nothing is lost).
-  double mass_now = sim.total_mass(), mass_initial = sim.initial_mass;
-  if (distributed) sim.ranks->sum(&mass_now, 1), sim.ranks->sum(&mass_initial, 1);
+  double masses[2] = {sim.total_mass(), sim.initial_mass};  // now, initial: over the ranks
+  sim.ranks->sum(masses, 2);
+  const double mass_now = masses[0], mass_initial = masses[1];
   res.summary["particles_created"] = sim.created;
   res.summary["particles_removed"] = sim.removed;
   res.summary["mass"] = {
@@ -800,6 +801,8 @@ RunResult Run<D>::loop() {
       for (auto& pr : probes_) pr.csv.close();
       writer_->close();
     });
+    // Every rank reports the same write failure (a rank's file may have failed alone).
+    if (distributed) write_error = sim.ranks->first_message(write_error);
     if (!write_error.empty()) {
       // Keep what was written: the history and probe rows so far are renamed to their names.
       history_.close(false);
@@ -811,19 +814,18 @@ RunResult Run<D>::loop() {
       res.summary["status"] = "write_failed";
       res.summary["write_error"] = write_error;
     }
-    if (distributed) write_error = sim.ranks->first_message(write_error);
-    if (!sim.ranks->root()) {
-      // summary.json is the first rank's
-    } else if (write_error.empty()) {
-      guarded([&] { write_summary(res.summary); });
-      if (!write_error.empty()) {  // only summary.json failed
-        res.exit_code = 4;
-        res.message += "loam: error: " + write_error + "\n";
-      }
-    } else {
-      try {  // the summary with status write_failed, if the disk still takes it
-        write_summary(res.summary);
-      } catch (const std::exception&) {
+    if (sim.ranks->root()) {  // summary.json is the first rank's
+      if (write_error.empty()) {
+        guarded([&] { write_summary(res.summary); });
+        if (!write_error.empty()) {  // only summary.json failed
+          res.exit_code = 4;
+          res.message += "loam: error: " + write_error + "\n";
+        }
+      } else {
+        try {  // the summary with status write_failed, if the disk still takes it
+          write_summary(res.summary);
+        } catch (const std::exception&) {
+        }
       }
     }
   }

@@ -50,17 +50,13 @@ bool Simulation<D>::advance(double step_dt, bool check) {
   if (track) timed("motion", [&] { motion_speed = largest_move(dt); });
   exchange_particles();
   if (distributed) timed("migration", [&] { migrate_particles(); });
-  // Check before sorting: the sort must not see non-finite positions.
-  if (checked) {
-    bool ok = true;
-    timed("check_particles", [&] { ok = failure.empty() && check_particles(failure); });
-    if (distributed) failure = ranks->first_message(failure), ok = failure.empty();
-    if (!ok) return false;
-    checked_step = step;
-  } else if (distributed) {
-    failure = ranks->first_message(failure);  // a particle that could not be handed over
-    if (!failure.empty()) return false;
-  }
+  // Check before sorting: the sort must not see non-finite positions. Under mpirun every rank
+  // stops on the first rank's failure, a particle that could not be handed over included.
+  bool ok = true;
+  if (checked) timed("check_particles", [&] { ok = failure.empty() && check_particles(failure); });
+  if (distributed) failure = ranks->first_message(failure), ok = failure.empty();
+  if (!ok) return false;
+  if (checked) checked_step = step;
   timed("partition", [&] { maintain_partition(); });
   if (checked && keep_last_good) timed("last_good_copy", [&] { save_last_good(); });
   return true;

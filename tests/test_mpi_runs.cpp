@@ -212,6 +212,19 @@ std::string terzaghi_1d() {
          "         fields: [velocity, stress, mass, pore_pressure, water_velocity, porosity]}\n";
 }
 
+/// `mpirun -np ranks loam run` of dir/run.yaml is refused: exit 2, every expected located
+/// error in its output, no output directory.
+void check_refused(const fs::path& dir, int ranks, const std::vector<std::string>& expected) {
+  const auto r = run_on(dir, "out", ranks);
+  std::printf("mpirun -np %d, refused: exit %d\n%s", ranks, r.exit_code, r.output.c_str());
+  CHECK(r.exit_code == 2);
+  for (const auto& e : expected) {
+    INFO(e);
+    CHECK(r.output.find(e) != std::string::npos);
+  }
+  CHECK(!fs::exists(dir / "out"));
+}
+
 /// history.csv's columns that the ranks must reproduce, per step.
 const std::vector<std::string> kHistory = {"time",           "kinetic_energy", "strain_energy",
                                            "gravity_energy", "momentum_x",     "momentum_y",
@@ -362,19 +375,12 @@ TEST_CASE("mpirun: what does not run on ranks yet is refused with located errors
          "time: {end: 0.1}\n"
          "probes:\n"
          "  - {name: corner, particle_near: [0.2, 0.2], fields: [velocity]}\n";
-  const auto r = run_on(dir.path, "out", 2);
-  std::printf("mpirun -np 2 with unsupported features: exit %d\n%s", r.exit_code, r.output.c_str());
-  CHECK(r.exit_code == 2);
-  for (const std::string expected :
-       {"run.yaml:2:17: error: shape_function: 'cpdi' does not run under mpirun yet",
-        "run.yaml:9:5: error: loads.0: 'point' does not run under mpirun yet",
-        "run.yaml:11:5: error: boundaries.0: 'fixed' does not run under mpirun yet",
-        "run.yaml:12:5: error: boundaries.1: 'absorbing' does not run under mpirun yet",
-        "run.yaml:15:3: error: probes: this key does not run under mpirun yet"}) {
-    INFO(expected);
-    CHECK(r.output.find(expected) != std::string::npos);
-  }
-  CHECK(!fs::exists(dir.path / "out"));
+  check_refused(dir.path, 2,
+                {"run.yaml:2:17: error: shape_function: 'cpdi' does not run under mpirun yet",
+                 "run.yaml:9:5: error: loads.0: 'point' does not run under mpirun yet",
+                 "run.yaml:11:5: error: boundaries.0: 'fixed' does not run under mpirun yet",
+                 "run.yaml:12:5: error: boundaries.1: 'absorbing' does not run under mpirun yet",
+                 "run.yaml:15:3: error: probes: this key does not run under mpirun yet"});
 
   // Four ranks on a grid of 3 cells along x: a gimp block needs 2 (its reach).
   std::ofstream(dir.path / "run.yaml")
@@ -382,12 +388,9 @@ TEST_CASE("mpirun: what does not run on ranks yet is refused with located errors
          "bodies:\n  - name: bar\n    generator: {type: box, min: [0], max: [0.3]}\n"
          "    material: {type: linear_elastic, E: 1000, nu: 0.3, density: 1000}\n"
          "time: {end: 0.1}\n";
-  const auto thin = run_on(dir.path, "out", 4);
-  std::printf("mpirun -np 4 on 3 cells: exit %d\n%s", thin.exit_code, thin.output.c_str());
-  CHECK(thin.exit_code == 2);
-  CHECK(thin.output.find("run.yaml:1:7: error: grid: the grid has 3 cells along x for 4 ranks: "
-                         "a block needs at least 2 cells") != std::string::npos);
-  CHECK(!fs::exists(dir.path / "out"));
+  check_refused(dir.path, 4,
+                {"run.yaml:1:7: error: grid: the grid has 3 cells along x for 4 ranks: a block "
+                 "needs at least 2 cells"});
 }
 
 #endif  // LOAM_MPI_BUILD

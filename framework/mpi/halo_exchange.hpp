@@ -34,6 +34,12 @@ class HaloExchange {
   void reverse(const std::vector<NodalArray>& arrays);
   /// Owners' values copied to the ghosts that mirror them.
   void forward(const std::vector<NodalArray>& arrays);
+  /// Sums completed over the ranks: reverse, then forward, so that every stored copy holds the
+  /// total (what a scheme needs after a scatter; Ranks::complete_nodes).
+  void complete(const std::vector<NodalArray>& arrays) {
+    reverse(arrays);
+    forward(arrays);
+  }
 
   /// Messages and bytes this rank has sent, over every exchange so far.
   long messages_sent() const { return messages_; }

@@ -36,14 +36,12 @@ bool MpiRanks<D>::owns(const std::array<double, D>& x) const {
 
 template <int D>
 void MpiRanks<D>::complete_nodes(const std::vector<NodalArray>& arrays) {
-  halo_->reverse(arrays);
-  halo_->forward(arrays);
+  halo_->complete(arrays);
 }
 
 template <int D>
 void MpiRanks<D>::complete_cells(double* sums, int K) {
-  cell_halo_->reverse({{sums, K, K}});
-  cell_halo_->forward({{sums, K, K}});
+  cell_halo_->complete({{sums, K, K}});
 }
 
 template <int D>
@@ -56,24 +54,26 @@ bool MpiRanks<D>::migrate(Particles<D>& P, long& strays, long& first_stray) {
 }
 
 template <int D>
-double MpiRanks<D>::min(double v) const {
-  double r = v;
-  mpi_check(MPI_Allreduce(&v, &r, 1, MPI_DOUBLE, MPI_MIN, cart_.comm()), "MPI_Allreduce");
+template <class T>
+T MpiRanks<D>::all_reduce(T v, MPI_Datatype type, MPI_Op op) const {
+  T r = v;
+  mpi_check(MPI_Allreduce(&v, &r, 1, type, op, cart_.comm()), "MPI_Allreduce");
   return r;
+}
+
+template <int D>
+double MpiRanks<D>::min(double v) const {
+  return all_reduce(v, MPI_DOUBLE, MPI_MIN);
 }
 
 template <int D>
 double MpiRanks<D>::max(double v) const {
-  double r = v;
-  mpi_check(MPI_Allreduce(&v, &r, 1, MPI_DOUBLE, MPI_MAX, cart_.comm()), "MPI_Allreduce");
-  return r;
+  return all_reduce(v, MPI_DOUBLE, MPI_MAX);
 }
 
 template <int D>
 int MpiRanks<D>::max(int v) const {
-  int r = v;
-  mpi_check(MPI_Allreduce(&v, &r, 1, MPI_INT, MPI_MAX, cart_.comm()), "MPI_Allreduce");
-  return r;
+  return all_reduce(v, MPI_INT, MPI_MAX);
 }
 
 template <int D>
@@ -85,9 +85,7 @@ void MpiRanks<D>::sum(double* values, int n) const {
 
 template <int D>
 std::string MpiRanks<D>::first_message(const std::string& mine) const {
-  const int me = mine.empty() ? cart_.size() : cart_.rank();
-  int first = me;
-  mpi_check(MPI_Allreduce(&me, &first, 1, MPI_INT, MPI_MIN, cart_.comm()), "MPI_Allreduce");
+  const int first = all_reduce(mine.empty() ? cart_.size() : cart_.rank(), MPI_INT, MPI_MIN);
   if (first == cart_.size()) return "";
   int length = int(mine.size());
   mpi_check(MPI_Bcast(&length, 1, MPI_INT, first, cart_.comm()), "MPI_Bcast");

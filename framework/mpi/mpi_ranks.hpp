@@ -44,6 +44,10 @@ class MpiRanks : public Ranks<D> {
   void barrier() const override;
 
  private:
+  /// MPI_Allreduce of one value over the ranks.
+  template <class T>
+  T all_reduce(T v, MPI_Datatype type, MPI_Op op) const;
+
   CartesianRanks<D> cart_;
   const Grid<D>* grid_ = nullptr;
   std::unique_ptr<Decomposition<D>> decomposition_;

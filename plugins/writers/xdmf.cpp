@@ -129,7 +129,7 @@ class Xdmf : public Writer<D> {
     Frame fr;
     std::string error, failed_file;
     try {
-      fr = write_particles(sim, set, std::string(stem) + piece_suffix(ranks.rank()));
+      fr = write_particles(sim, set, std::string(stem) + piece_tag(ranks.rank()) + ".h5");
     } catch (const WriteError& e) {
       error = e.what(), failed_file = e.file;
     }
@@ -140,9 +140,11 @@ class Xdmf : public Writer<D> {
     if (ranks.root()) write_index(set.name, frames_[s], false);
   }
 
-  static std::string piece_suffix(int rank) {
+  /// What names a rank's piece of a frame: _rRRRR (its file <stem>_rRRRR.h5, its grid
+  /// <set>_rRRRR in the index).
+  static std::string piece_tag(int rank) {
     char s[32];
-    std::snprintf(s, sizeof s, "_r%04d.h5", rank);
+    std::snprintf(s, sizeof s, "_r%04d", rank);
     return s;
   }
 
@@ -272,7 +274,7 @@ class Xdmf : public Writer<D> {
         << "CollectionType=\"Spatial\">\n        <Time Value=\"" << fr.time << "\"/>\n";
       for (size_t r = 0; r < fr.pieces.size(); ++r)
         if (fr.pieces[r] > 0)
-          polyvertex(x, set + piece_suffix(int(r)).substr(0, 6), fr.file + piece_suffix(int(r)), "",
+          polyvertex(x, set + piece_tag(int(r)), fr.file + piece_tag(int(r)) + ".h5", "",
                      size_t(fr.pieces[r]), fr.attributes, fr.time, true);
       x << "      </Grid>\n";
     }
