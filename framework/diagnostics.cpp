@@ -10,7 +10,11 @@ std::string Diagnostic::format() const {
   s << (where.file.empty() ? "<input>" : where.file) << ':' << std::max(where.line, 1) << ':'
     << std::max(where.column, 1) << ": error: " << (path.empty() ? "<document>" : path) << ": "
     << message;
-  return s.str();
+  // One line per error, whatever it quotes: a key or value taken from the file may span lines
+  // (a plain YAML scalar continued on the next lines), and its line breaks are shown as \n.
+  std::string line;
+  for (char c : s.str()) line += c == '\n' ? "\\n" : c == '\r' ? "\\r" : std::string(1, c);
+  return line;
 }
 
 void Diagnostics::error(const Location& where, const std::string& path,

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "framework/diagnostics.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -629,4 +631,19 @@ time: {end: 0.1}
                   "(particles at y = 0.625 and 0.875 m on one line): a traction loads every "
                   "selected particle with t A_p, so the load would be multiplied; select only "
                   "the surface layer")});
+}
+
+TEST_CASE("an error quoting a key that spans lines is still one located line", "[bad_config]") {
+  // A plain YAML scalar continues on the next, more indented lines, so a stray character can
+  // turn a value and the lines after it into one long key: the [full] fuzz suite found this in
+  // seed002_blast_3d.yaml, whose "unknown key" error then broke over several unlocated lines.
+  // Diagnostic::format keeps every error on one FILE:LINE:COL line, line breaks shown as \n.
+  loam::Diagnostics diag;
+  diag.error(loam::Location{"run.yaml", 32, 5}, "bodies.0.  minus: [a]\n  # comment",
+             "unknown key '  minus: [a]\n  # comment\r\n'");
+  const std::string text = diag.format();
+  std::printf("%s", text.c_str());
+  CHECK(text ==
+        "run.yaml:32:5: error: bodies.0.  minus: [a]\\n  # comment: unknown key '  minus: "
+        "[a]\\n  # comment\\r\\n'\n");
 }
