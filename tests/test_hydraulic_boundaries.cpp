@@ -233,13 +233,14 @@ TEST_CASE("hydraulic: prescribed pore pressure at the base drives steady upward 
   // head = 5000 / 9810 m at the base (z = 0), must give the same run to 1e-6.
   const double end = 2.5 / kCv;
   const std::string fixed = "  - {type: fixed, face: x-}\n";
-  for (double x : {0.0, 0.5}) {
-    auto pr = run_column(fixed + "  - {type: prescribed_pore_pressure, face: x-, pressure: 5000}\n",
-                         x, end);
-    auto hd = run_column(fixed + "  - {type: prescribed_pore_pressure, face: x-, head: " +
-                             std::to_string(5000.0 / 9810.0) + "}\n",
-                         x, end);
-    const Sample &a = pr.back(), &b = hd.back();
+  // One run per form, each probing the base and the mid particle.
+  auto pr = run_column_probes(
+      fixed + "  - {type: prescribed_pore_pressure, face: x-, pressure: 5000}\n", {0.0, 0.5}, end);
+  auto hd = run_column_probes(fixed + "  - {type: prescribed_pore_pressure, face: x-, head: " +
+                                  std::to_string(5000.0 / 9810.0) + "}\n",
+                              {0.0, 0.5}, end);
+  for (size_t k = 0; k < 2; ++k) {
+    const Sample &a = pr.probes[k].back(), &b = hd.probes[k].back();
     const double p_exact = 5000 * (1 - a.x);
     std::printf(
         "prescribed base pore pressure 5 kPa, particle at z = %.4f: p = %.1f Pa (exact "
