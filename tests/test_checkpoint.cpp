@@ -184,18 +184,20 @@ TEST_CASE("an unstable run checkpoints its last good state and resuming it fails
 
 TEST_CASE("an interrupted run resumes to the uninterrupted run's final state",
           "[checkpoint][interrupt]") {
-  // SIGINT after 1 s writes a checkpoint with the last frame; `--resume DIR` finishes the run.
-  // The final frame, history and summary numbers equal those of a run never interrupted (the
-  // frames in between differ only in their number: the interruption added one).
+  // SIGINT 0.5 s after the first frame writes a checkpoint with the last frame; `--resume DIR`
+  // finishes the run. The final frame, history and summary numbers equal those of a run never
+  // interrupted (the frames in between differ only in their number: the interruption added one).
   loam_test::TempDir a("ckpt_int_a"), b("ckpt_int_b");
   const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/vibrating_bar.yaml";
   const std::string args =
       " --quiet --threads 1 --set time.end=5000 --set output.every_time=500 "
       "--set \"output.checkpoint={every_steps: 20000}\"";
   REQUIRE(loam_test::run_loam("run " + cfg + " --out " + a.path.string() + args).exit_code == 0);
-  const int code =
-      loam_test::run_bash(std::string(LOAM_EXE) + " run " + cfg + " --out " + b.path.string() +
-                          args + " & pid=$!; sleep 1; kill -INT $pid; wait $pid");
+  const int code = loam_test::run_bash(
+      std::string(LOAM_EXE) + " run " + cfg + " --out " + b.path.string() + args +
+      " & pid=$!; while [ ! -e " + (b.path / "particles_000000.h5").string() +
+      " ] && kill -0 $pid 2>/dev/null; do sleep 0.01; done; sleep 0.5; "
+      "kill -INT $pid; wait $pid");
   auto interrupted = nlohmann::json::parse(loam_test::slurp(b.path / "summary.json"));
   std::printf("interrupted at step %ld (exit %d); resuming\n", interrupted["steps"].get<long>(),
               code);
