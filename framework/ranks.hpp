@@ -43,8 +43,18 @@ class Ranks {
                                 int /*threads*/) {
     return "";
   }
-  /// Whether this rank owns the cell of point x (its particles are generated and kept here).
-  virtual bool owns(const std::array<double, D>& /*x*/) const { return true; }
+  /// This rank's block of grid cells, [lo, hi) per axis, where the block sits in the array of
+  /// blocks and that array's size. The particles of these cells are generated and kept here.
+  struct CellBlock {
+    std::array<int, D> lo{}, hi{}, coord{}, dims{};
+  };
+  /// Serially (or before the grid is split): the whole grid, one block.
+  virtual CellBlock cell_block(const Grid<D>& grid) const {
+    CellBlock b;
+    b.hi = grid.cells;
+    b.dims.fill(1);
+    return b;
+  }
 
   /// Complete nodal sums over the ranks after a scatter: each ghost node's share is added into
   /// its owner (in a fixed neighbour order), and the owner's total copied back to every ghost

@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "body_lattice.hpp"
 #include "registry.hpp"
 
 namespace loam {
@@ -233,10 +234,9 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
   Registry& reg = Registry::instance();
   const auto& bl = config.list("bodies");
   const size_t errors_before = diag.errors().size();
-  // The particles this rank keeps (all of them serially): position, body, volume and id. Every
-  // rank walks each body's whole lattice, so that the ids (numbered over all bodies in lattice
-  // order) and the bodies' bounding boxes are those of the serial run, and keeps the points of
-  // its own cells (Ranks::owns).
+  // The particles this rank keeps (all of them serially): position, body, volume and id. Each
+  // rank generates only the points of its own cells (walk_body_lattice); the ids (numbered over
+  // all bodies in lattice order) and the bodies' bounding boxes are those of the serial run.
   std::vector<Vec> xs;
   std::vector<uint16_t> owner;
   std::vector<double> vols;
@@ -286,43 +286,24 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
       i1[size_t(d)] =
           long(std::floor((hi[size_t(d)] - grid.origin[size_t(d)]) / s[size_t(d)] - 0.5 + 1e-9));
     }
-    std::array<long, D> i = i0;
-    bool empty_range = false;
-    for (int d = 0; d < D; ++d) empty_range = empty_range || i1[size_t(d)] < i0[size_t(d)];
-    Vec plo, phi;
-    plo.fill(1e300);
-    phi.fill(-1e300);
-    while (!empty_range) {
-      Vec x{};
-      for (int d = 0; d < D; ++d)
-        x[size_t(d)] = grid.origin[size_t(d)] + (double(i[size_t(d)]) + 0.5) * s[size_t(d)];
-      if (gen->contains(x)) {
-        if (ranks->owns(x)) {
-          xs.push_back(x);
-          owner.push_back(uint16_t(b));
-          vols.push_back(vol);
-          ids.push_back(next_id);
-        }
-        ++next_id;
-        for (int d = 0; d < D; ++d) {
-          plo[size_t(d)] = std::min(plo[size_t(d)], x[size_t(d)] - 0.5 * s[size_t(d)]);
-          phi[size_t(d)] = std::max(phi[size_t(d)], x[size_t(d)] + 0.5 * s[size_t(d)]);
-        }
-      }
-      int d = 0;
-      while (d < D && ++i[size_t(d)] > i1[size_t(d)]) i[size_t(d)] = i0[size_t(d)], ++d;
-      if (d == D) break;
+    const BodyLattice<D> lattice = walk_body_lattice<D>(grid, *ranks, *gen, ppc, s, i0, i1);
+    for (size_t p = 0; p < lattice.x.size(); ++p) {
+      xs.push_back(lattice.x[p]);
+      owner.push_back(uint16_t(b));
+      vols.push_back(vol);
+      ids.push_back(next_id + lattice.number[p]);
     }
-    body.count = next_id - body.first_id;
-    body.local_count = xs.size() - first_kept.back();
+    next_id += lattice.count;
+    body.count = lattice.count;
+    body.local_count = lattice.x.size();
     if (body.count == 0) {
       diag.error(bp.where("generator"), bp.path("generator"),
                  "the generator produced no particles (region smaller than the particle spacing " +
                      format_number(s[0]) + " m?)");
       continue;
     }
-    body.lower.assign(plo.begin(), plo.end());
-    body.upper.assign(phi.begin(), phi.end());
+    body.lower.assign(lattice.lower.begin(), lattice.lower.end());
+    body.upper.assign(lattice.upper.begin(), lattice.upper.end());
     body.spacing.assign(s.begin(), s.end());
     bodies.push_back(std::move(body));
   }

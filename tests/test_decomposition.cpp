@@ -8,9 +8,13 @@
 // gradients and affine geometry, bit for bit, on the same nodes. The exchange itself runs under
 // mpirun (tests/mpi/test_halo_exchange.cpp).
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <functional>
 #include <map>
+#include <tuple>
 
 #include "decomposition_scene.hpp"
+#include "framework/body_lattice.hpp"
 
 namespace {
 
@@ -269,4 +273,121 @@ TEST_CASE("decomposition: cell links cover the ring of cells around each block a
   check_cell_links<1>({{2}, {3}, {7}});
   check_cell_links<2>({{2, 1}, {2, 2}, {3, 2}, {4, 5}});
   check_cell_links<3>({{2, 2, 1}, {2, 2, 2}, {3, 2, 2}});
+}
+
+namespace {
+
+/// A ball that records every point it is asked about.
+template <int D>
+struct RecordingBall : loam::Generator<D> {
+  std::array<double, D> centre{};
+  double radius = 0;
+  mutable std::vector<std::array<double, D>> asked;
+  bool contains(const std::array<double, D>& x) const override {
+    asked.push_back(x);
+    double r2 = 0;
+    for (int d = 0; d < D; ++d)
+      r2 += (x[size_t(d)] - centre[size_t(d)]) * (x[size_t(d)] - centre[size_t(d)]);
+    return r2 <= radius * radius;
+  }
+  std::array<double, D> lower() const override {
+    auto lo = centre;
+    for (auto& v : lo) v -= radius;
+    return lo;
+  }
+  std::array<double, D> upper() const override {
+    auto hi = centre;
+    for (auto& v : hi) v += radius;
+    return hi;
+  }
+};
+
+/// One block of a rank array, with the sum over the ranks played by `sum_over_ranks`.
+template <int D>
+struct OneBlockRanks : loam::Ranks<D> {
+  typename loam::Ranks<D>::CellBlock block;
+  std::function<void(double*, int)> sum_over_ranks;
+  typename loam::Ranks<D>::CellBlock cell_block(const loam::Grid<D>&) const override {
+    return block;
+  }
+  void sum(double* values, int n) const override { sum_over_ranks(values, n); }
+};
+
+template <int D>
+void check_body_lattice(const std::array<int, D>& cells, const std::array<int, D>& dims, long ppc) {
+  loam::Grid<D> g;
+  std::array<double, D> origin{}, extent{}, h{};
+  for (int d = 0; d < D; ++d) extent[size_t(d)] = cells[size_t(d)], h[size_t(d)] = 1.0;
+  g.init(origin, extent, h);
+  RecordingBall<D> ball;
+  // A ball inside the grid (as the build requires of every body), off-centre.
+  ball.radius = 0.4 * double(*std::min_element(cells.begin(), cells.end()));
+  for (size_t d = 0; d < size_t(D); ++d) ball.centre[d] = 0.45 * double(cells[d]);
+  std::array<double, D> s{};
+  std::array<long, D> i0{}, i1{};
+  for (size_t d = 0; d < size_t(D); ++d) {
+    s[d] = 1.0 / double(ppc);
+    i0[d] = long(std::ceil((ball.lower()[d]) / s[d] - 0.5 - 1e-9));
+    i1[d] = long(std::floor((ball.upper()[d]) / s[d] - 0.5 + 1e-9));
+  }
+  const loam::Ranks<D> serial_ranks;
+  const auto serial = loam::walk_body_lattice<D>(g, serial_ranks, ball, ppc, s, i0, i1);
+  REQUIRE(serial.count == serial.x.size());
+  for (size_t p = 0; p < serial.x.size(); ++p) REQUIRE(serial.number[p] == p);
+  // Pass 1 gathers every block's counts (the sum over the ranks); pass 2 numbers the points.
+  const auto blocks = every_block<D>(dims);
+  std::vector<double> total;
+  std::map<size_t, std::array<double, D>> numbered;
+  size_t asked = 0;
+  for (int pass = 1; pass <= 2; ++pass)
+    for (const auto& c : blocks) {
+      OneBlockRanks<D> ranks;
+      ranks.block.coord = c;
+      ranks.block.dims = dims;
+      for (size_t d = 0; d < size_t(D); ++d)
+        std::tie(ranks.block.lo[d], ranks.block.hi[d]) = loam::split_range(cells[d], dims[d], c[d]);
+      ranks.sum_over_ranks = [&](double* v, int n) {
+        if (pass == 1) {
+          total.resize(size_t(n), 0.0);
+          for (int k = 0; k < n; ++k) total[size_t(k)] += v[k];
+        } else {
+          std::copy(total.begin(), total.end(), v);
+        }
+      };
+      ball.asked.clear();
+      const auto mine = loam::walk_body_lattice<D>(g, ranks, ball, ppc, s, i0, i1);
+      // The block tested only points of its own cells, and kept those in the ball.
+      for (const auto& x : ball.asked)
+        for (size_t d = 0; d < size_t(D); ++d) {
+          REQUIRE(int(x[d]) >= ranks.block.lo[d]);
+          REQUIRE(int(x[d]) < ranks.block.hi[d]);
+        }
+      if (pass == 1) asked += ball.asked.size();
+      if (pass == 2) {
+        CHECK(mine.count == serial.count);
+        for (size_t p = 0; p < mine.x.size(); ++p) numbered[mine.number[p]] = mine.x[p];
+      }
+    }
+  // Every lattice point of the body's box was tested once over all blocks, and the blocks'
+  // numbers are the serial walk's: each number once, at the same point.
+  size_t box_points = 1;
+  for (size_t d = 0; d < size_t(D); ++d) box_points *= size_t(i1[d] - i0[d] + 1);
+  CHECK(asked == box_points);
+  REQUIRE(numbered.size() == serial.x.size());
+  for (size_t p = 0; p < serial.x.size(); ++p) CHECK(numbered.at(p) == serial.x[p]);
+}
+
+}  // namespace
+
+TEST_CASE(
+    "body lattice: a block generates only its own cells' points and numbers them as the serial "
+    "walk does",
+    "[decomposition][generation]") {
+  // framework/body_lattice.hpp: under mpirun no rank walks the whole lattice; the ids still
+  // count the body's points in lattice order over the whole grid (the mpirun runs of
+  // tests/test_mpi_runs.cpp check the ids of whole runs against the serial run).
+  check_body_lattice<1>({23}, {3}, 2);
+  check_body_lattice<2>({13, 11}, {3, 2}, 2);
+  check_body_lattice<2>({12, 9}, {1, 4}, 3);
+  check_body_lattice<3>({9, 8, 7}, {2, 2, 2}, 2);
 }

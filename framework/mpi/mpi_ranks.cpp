@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include "mpi_error.hpp"
 
@@ -27,11 +28,14 @@ std::string MpiRanks<D>::decompose(Grid<D>& grid, int rows_below, int rows_above
 }
 
 template <int D>
-bool MpiRanks<D>::owns(const std::array<double, D>& x) const {
-  if (!decomposition_) return true;  // not split (the model has errors): checked as a whole
-  std::array<int, D> cell{};
-  for (int d = 0; d < D; ++d) cell[size_t(d)] = grid_->cell_of(x[size_t(d)], d);
-  return decomposition_->owns_cell(cell);
+typename Ranks<D>::CellBlock MpiRanks<D>::cell_block(const Grid<D>& grid) const {
+  if (!decomposition_) return Ranks<D>::cell_block(grid);  // not split (the model has errors)
+  typename Ranks<D>::CellBlock b;
+  for (int d = 0; d < D; ++d)
+    std::tie(b.lo[size_t(d)], b.hi[size_t(d)]) = decomposition_->cells_of(cart_.coords(), d);
+  b.coord = cart_.coords();
+  b.dims = cart_.dims();
+  return b;
 }
 
 template <int D>

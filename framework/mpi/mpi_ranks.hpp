@@ -29,7 +29,7 @@ class MpiRanks : public Ranks<D> {
   const ParticleMigration<D>* migration() const { return migration_.get(); }
 
   std::string decompose(Grid<D>& grid, int rows_below, int rows_above, int threads) override;
-  bool owns(const std::array<double, D>& x) const override;
+  typename Ranks<D>::CellBlock cell_block(const Grid<D>& grid) const override;
   void complete_nodes(const std::vector<NodalArray>& arrays) override;
   void complete_cells(double* sums, int K) override;
   bool migrate(Particles<D>& P, long& strays, long& first_stray) override;
