@@ -18,6 +18,9 @@
 
 namespace loam {
 
+/// "_rRRRR": names rank r's file among the ranks' files of one output.
+std::string rank_tag(int rank);
+
 /// A nodal array as the exchanges see it: node n's `width` values start at
 /// data[n * stride + offset] (a scheme's interleaved record, or one field of it).
 struct NodalArray {
@@ -35,6 +38,9 @@ class Ranks {
   virtual int rank() const { return 0; }
   virtual int size() const { return 1; }
   bool root() const { return rank() == 0; }
+  /// What ends the name of this rank's own file of an output split over the ranks (its piece
+  /// of a frame, its checkpoint): rank_tag(rank()) under mpirun, "" serially.
+  std::string file_tag() const { return distributed() ? rank_tag(rank()) : ""; }
 
   /// Split the grid: this rank's box of nodes is stored in `grid` (Grid::store_nodes), which
   /// must outlive the ranks; `threads` pack and unpack the messages. Returns "" or why the grid

@@ -154,6 +154,7 @@ class Run {
   fs::path write_checkpoint(const CheckpointImage& image);
   void restore_checkpoint();
   std::string find_resume_checkpoint();
+  std::string resume_layout_hint(const fs::path& dir) const;
 
   // Output (run_output.cpp).
   void check_outputs(Diagnostics& diag);

@@ -157,12 +157,9 @@ void Run<D>::check_outputs(Diagnostics& diag) {
   }
   if (sim_->ranks->distributed()) {  // what the output cannot do under mpirun yet
     const std::string only = " does not run under mpirun yet (docs/parallel.md lists what does)";
-    if (out.given("checkpoint"))
-      diag.error(out.where("checkpoint"), out.path("checkpoint"), "checkpoint" + only);
     const Params& w = out.section("writer");
     if (w.has("grid") && w.flag("grid"))
       diag.error(w.where("grid"), w.path("grid"), "the grid output" + only);
-    if (!opt_.resume.empty()) diag.error(cfg_.params.where(), "--resume", "--resume" + only);
   }
 }
 

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "checkpoint.hpp"
@@ -24,21 +25,35 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// The checkpoint_<step>.h5 files of an output directory, oldest first (the zero-padded step
-/// sorts by name).
-std::vector<std::filesystem::path> checkpoint_files(const std::filesystem::path& dir) {
-  std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::directory_iterator(dir)) {
-    const std::string n = e.path().filename().string();
-    if (n.rfind("checkpoint_", 0) == 0 && e.path().extension() == ".h5") files.push_back(e.path());
-  }
-  std::sort(files.begin(), files.end());
-  return files;
+/// A checkpoint's name: checkpoint_<step, 8 digits><tag>.h5, the tag naming the rank's own file
+/// under mpirun (Ranks::file_tag, "" serially).
+std::string checkpoint_name(long step, const std::string& tag) {
+  char name[64];
+  std::snprintf(name, sizeof name, "checkpoint_%08ld", step);
+  return name + tag + ".h5";
 }
 
-/// The step in a checkpoint's name.
-long checkpoint_step(const std::filesystem::path& file) {
-  return std::stol(file.filename().string().substr(11));
+/// The step in a checkpoint's name, or -1 if the name is not a checkpoint's with this tag.
+long checkpoint_step(const std::filesystem::path& file, const std::string& tag = "") {
+  const std::string n = file.filename().string();
+  constexpr size_t kDigits = 8, kPrefix = 11;  // "checkpoint_"
+  if (n.size() != kPrefix + kDigits + tag.size() + 3 || n.rfind("checkpoint_", 0) != 0 ||
+      n.compare(kPrefix + kDigits, std::string::npos, tag + ".h5") != 0)
+    return -1;
+  for (size_t k = kPrefix; k < kPrefix + kDigits; ++k)
+    if (n[k] < '0' || n[k] > '9') return -1;
+  return std::stol(n.substr(kPrefix, kDigits));
+}
+
+/// The checkpoints of an output directory with this tag (a rank's own under mpirun), oldest
+/// first (the zero-padded step sorts by name).
+std::vector<std::filesystem::path> checkpoint_files(const std::filesystem::path& dir,
+                                                    const std::string& tag) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (checkpoint_step(e.path(), tag) >= 0) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  return files;
 }
 
 /// A reference's time series as CSV (a column per series, full precision), written whole or not
@@ -216,13 +231,12 @@ typename Run<D>::CheckpointImage Run<D>::checkpoint_image() {
 template <int D>
 fs::path Run<D>::write_checkpoint(const CheckpointImage& image) {
   const Simulation<D>& sim = *sim_;
-  char name[64];
-  std::snprintf(name, sizeof name, "checkpoint_%08ld.h5", image.step);
-  const fs::path file = dir_ / name;
+  const fs::path file = dir_ / checkpoint_name(image.step, sim.ranks->file_tag());
   CheckpointWriter w(file.string());
   w.text("meta.format", "loam checkpoint 1");
   w.text("meta.version", loam_version() + " " + git_commit());
   w.text("meta.config", cfg_.params.to_json().dump());
+  w.scalar("meta.ranks", double(sim.ranks->size()));
   for (const auto& [k, v] : image.scalars) w.scalar(k, v);
   w.doubles("run.e0.momentum", image.momentum);
   for (size_t k = 0; k < sim.sets.size(); ++k) {
@@ -338,8 +352,8 @@ void Run<D>::restore_checkpoint() {
     if (probe.clear(), sim.boundaries[i]->save_state(probe))
       sim.boundaries[i]->restore_state(r.doubles("plugin.boundary." + std::to_string(i)));
   // The checkpoints of the run so far, and none from beyond this one (that future is redone).
-  for (const auto& file : checkpoint_files(dir_)) {
-    if (checkpoint_step(file) > sim.step) {
+  for (const auto& file : checkpoint_files(dir_, sim.ranks->file_tag())) {
+    if (checkpoint_step(file, sim.ranks->file_tag()) > sim.step) {
       std::error_code ec;
       fs::remove(file, ec);
     } else {
@@ -349,43 +363,107 @@ void Run<D>::restore_checkpoint() {
 }
 
 /// --resume DIR (its newest readable checkpoint) or --resume FILE: sets dir_ and
-/// resume_file_, and checks that the checkpoint is this run's (config, version, commit).
+/// resume_file_, and checks that the checkpoint is this run's (config, version, commit, rank
+/// count). Under mpirun every rank reads its own file of one step: the newest step whose files
+/// every rank can read (a FILE names the step; each rank takes its own file of it).
 template <int D>
 std::string Run<D>::find_resume_checkpoint() {
+  const Ranks<D>& ranks = *sim_->ranks;
+  const std::string tag = ranks.file_tag();
   const fs::path given(opt_.resume);
   std::vector<fs::path> candidates;
+  std::string error;  // a checkpoint of another run: no older one is tried
   if (fs::is_directory(given)) {
     dir_ = given;
-    candidates = checkpoint_files(given);
+    candidates = checkpoint_files(given, tag);
     std::reverse(candidates.begin(), candidates.end());  // newest first
-    if (candidates.empty()) return "no checkpoint_*.h5 in " + given.string();
+    if (candidates.empty())
+      error = "no " + checkpoint_name(0, tag).replace(11, 8, "*") + " in " + given.string() +
+              resume_layout_hint(given);
   } else if (fs::exists(given)) {
     dir_ = given.parent_path().empty() ? fs::path(".") : given.parent_path();
-    candidates.push_back(given);
+    if (!ranks.distributed()) {
+      candidates.push_back(given);
+    } else {  // the same step's file of this rank
+      const std::string n = given.filename().string();
+      const long step = n.size() > 9 ? checkpoint_step(given, n.substr(n.size() - 9, 6)) : -1;
+      if (step < 0 || n.compare(n.size() - 9, 2, "_r") != 0)
+        error = "--resume " + given.string() +
+                ": under mpirun, give the output directory or a rank's checkpoint_<step>_rRRRR.h5";
+      else
+        candidates.push_back(dir_ / checkpoint_name(step, tag));
+    }
   } else {
-    return "--resume " + given.string() + ": no such directory or checkpoint file";
+    error = "--resume " + given.string() + ": no such directory or checkpoint file";
   }
   std::string why;
+  std::vector<double> readable;  // steps, newest first
   for (const auto& c : candidates) {
+    if (!error.empty()) break;
     try {
       CheckpointReader r(c.string());
       if (r.text("meta.format") != "loam checkpoint 1") {
         why = c.string() + " is not a loam checkpoint";
         continue;
       }
-      if (r.text("meta.version") != loam_version() + " " + git_commit())
-        return "checkpoint " + c.string() + " was written by loam " + r.text("meta.version") +
-               ", this is " + loam_version() + " " + git_commit() + ": resume with that binary";
-      if (r.text("meta.config") != cfg_.params.to_json().dump())
-        return "checkpoint " + c.string() + " belongs to another configuration (its config " +
-               "echo differs from this run's after overrides): resume with the same file and --set";
-      resume_file_ = c;
-      return "";
+      if (r.text("meta.version") != loam_version() + " " + git_commit()) {
+        error = "checkpoint " + c.string() + " was written by loam " + r.text("meta.version") +
+                ", this is " + loam_version() + " " + git_commit() + ": resume with that binary";
+      } else if (r.text("meta.config") != cfg_.params.to_json().dump()) {
+        error = "checkpoint " + c.string() + " belongs to another configuration (its config " +
+                "echo differs from this run's after overrides): resume with the same file and " +
+                "--set";
+      } else if (const int n = r.has("meta.ranks") ? int(r.scalar("meta.ranks")) : 1;
+                 n != ranks.size()) {
+        error = "checkpoint " + c.string() + " was written by a run on " + std::to_string(n) +
+                " rank(s), this one has " + std::to_string(ranks.size()) +
+                ": resume at the same rank count";
+      } else {
+        readable.push_back(double(std::max(0L, checkpoint_step(c, tag))));  // a FILE: any name
+        if (!ranks.distributed()) break;  // the newest readable one
+      }
     } catch (const std::exception& e) {
       why = e.what();  // an unreadable (e.g. cut) checkpoint: try the one before
     }
   }
-  return "no valid checkpoint to resume from: " + why;
+  if (ranks.distributed()) error = ranks.first_message(error);
+  if (!error.empty()) return error;
+  // The newest step every rank can read (each rank's list, its length first).
+  std::vector<double> mine{double(readable.size())};
+  mine.insert(mine.end(), readable.begin(), readable.end());
+  const std::vector<double> all = ranks.all_gather(mine);
+  std::map<long, int> readers;
+  int lists = 0;
+  for (size_t i = 0; i < all.size(); ++lists)
+    for (size_t n = size_t(all[i++]); n > 0; --n) ++readers[long(all[i++])];
+  long step = -1;
+  for (const auto& [s, count] : readers)
+    if (count == lists) step = std::max(step, s);
+  if (step < 0) {
+    if (ranks.distributed() && why.empty()) why = "no step has a readable file on every rank";
+    return "no valid checkpoint to resume from: " + ranks.first_message(why);
+  }
+  resume_file_ = candidates.size() == 1 ? candidates[0] : dir_ / checkpoint_name(step, tag);
+  return "";
+}
+
+/// Why a directory has no checkpoint for this run's ranks: its checkpoints were written by a run
+/// on another rank count (" ..." or "").
+template <int D>
+std::string Run<D>::resume_layout_hint(const fs::path& dir) const {
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string n = e.path().filename().string();
+    if (n.rfind("checkpoint_", 0) != 0 || e.path().extension() != ".h5") continue;
+    try {
+      CheckpointReader r(e.path().string());
+      const int ranks = r.has("meta.ranks") ? int(r.scalar("meta.ranks")) : 1;
+      return " (its checkpoints were written by a run on " + std::to_string(ranks) +
+             " rank(s): resume at that rank count)";
+    } catch (const std::exception&) {
+      continue;
+    }
+  }
+  return "";
 }
 
 template <int D>
@@ -569,13 +647,15 @@ RunResult Run<D>::loop() {
                     (every_time > 0 && next_time >= ls_.next_frame_time * (1 - 1e-9)));
       const bool last_of_stage = next_time >= t_end * (1 - 1e-12);
       bool last = last_of_stage || next_step == opt_.max_steps;
-      // A checkpoint is written only of a state that passed the check.
+      // A checkpoint is written only of a state that passed the check. Under mpirun every rank
+      // writes its file of the same step: the wall-clock interval is up when it is on any rank.
+      bool wall_due =
+          checkpoint_wall_ > 0 &&
+          std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >= checkpoint_wall_;
+      if (distributed && checkpoint_wall_ > 0) wall_due = sim.ranks->max(int(wall_due)) != 0;
       const bool checkpoint_due =
           files && !last &&
-          ((checkpoint_every_ > 0 && next_step % checkpoint_every_ == 0) ||
-           (checkpoint_wall_ > 0 &&
-            std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >=
-                checkpoint_wall_));
+          ((checkpoint_every_ > 0 && next_step % checkpoint_every_ == 0) || wall_due);
       if (!sim.advance(dt, frame_due || last || checkpoint_due)) {
         failure = sim.failure;
         break;

@@ -352,6 +352,100 @@ TEST_CASE("mpirun -np 1, 2 and 4: whole runs match the serial run, every shape f
   }
 }
 
+TEST_CASE("mpirun: a run resumed from its ranks' checkpoints is bitwise the uninterrupted one",
+          "[mpi][mpi_run][checkpoint]") {
+  // docs/parallel.md "Checkpoints": every rank writes checkpoint_<step>_rRRRR.h5 of the same
+  // step (its own particles, partition and writer state; the run's scalars), and --resume
+  // restarts each rank from its own file at the same rank count. A run copied at the end and
+  // resumed from the checkpoint of a step between two frames must rewrite every file of the
+  // uninterrupted run bit for bit: each rank's frame pieces, the XDMF index, history.csv and
+  // summary.json's numbers. Resuming at another rank count, or a serial run's checkpoints under
+  // mpirun, is refused with the reason.
+  struct Case {
+    std::string name, yaml;
+    int ranks;
+    long from;
+  };
+  const std::vector<Case> cases = {
+      {"2D disks gimp, 2 ranks", disks(2, "gimp"), 2, 120},
+      {"2D disks gimp, 4 ranks", disks(2, "gimp"), 4, 90},
+      {"2D saturated disks gimp, 2 ranks",
+       disks(2, "gimp",
+             "{type: two_phase_single_point, porosity: 0.4, water_bulk_modulus: 1.0e4, drag: "
+             "{type: darcy, hydraulic_conductivity: 1.0e-3}}",
+             "{end: 0.6, dt: 0.0015}"),
+       2, 240}};
+  const std::string ck = "--set 'output.checkpoint={every_steps: 30, keep: 100}'";
+  for (const Case& c : cases) {
+    INFO(c.name);
+    TempDir dir("mpi_resume");
+    fs::create_directories(dir.path);
+    std::ofstream(dir.path / "run.yaml") << c.yaml;
+    const auto a = run_on(dir.path, "a", c.ranks, ck);
+    INFO(a.output);
+    REQUIRE(a.exit_code == 0);
+    char name[64];
+    for (int r = 0; r < c.ranks; ++r) {
+      std::snprintf(name, sizeof name, "checkpoint_%08ld_r%04d.h5", c.from, r);
+      REQUIRE(fs::exists(dir.path / "a" / name));
+    }
+    fs::copy(dir.path / "a", dir.path / "b", fs::copy_options::recursive);
+    fs::remove(dir.path / "b" / "summary.json");
+    std::snprintf(name, sizeof name, "checkpoint_%08ld_r0000.h5", c.from);
+    const auto b =
+        run_on(dir.path, "b", c.ranks, ck + " --resume " + (dir.path / "b" / name).string());
+    INFO(b.output);
+    REQUIRE(b.exit_code == 0);
+    long files = 0, frames = 0;
+    for (const auto& e : fs::directory_iterator(dir.path / "a")) {
+      const std::string n = e.path().filename().string();
+      const std::string ext = e.path().extension().string();
+      INFO(n);
+      if (ext == ".csv" || ext == ".xdmf") {
+        CHECK(loam_test::slurp(e.path()) == loam_test::slurp(dir.path / "b" / n));
+        ++files;
+      } else if (ext == ".h5" && n.rfind("particles_", 0) == 0) {
+        for (const auto& field : dataset_names(e.path()))
+          if (field != "id")
+            CHECK(loam_test::read_frame_doubles(e.path(), field) ==
+                  loam_test::read_frame_doubles(dir.path / "b" / n, field));
+        CHECK(loam_test::read_frame_ids(e.path()) == loam_test::read_frame_ids(dir.path / "b" / n));
+        ++frames;
+      }
+    }
+    auto sa = nlohmann::json::parse(loam_test::slurp(dir.path / "a" / "summary.json"));
+    auto sb = nlohmann::json::parse(loam_test::slurp(dir.path / "b" / "summary.json"));
+    for (const char* k :
+         {"wall_seconds", "particle_steps_per_second", "profile_seconds", "config_file"})
+      sa.erase(k), sb.erase(k);
+    CHECK(sa == sb);
+    std::printf("%s: resumed from step %ld, %ld frame pieces and %ld index/CSV files compared\n",
+                c.name.c_str(), c.from, frames, files);
+    CHECK(frames >= 5 * c.ranks);
+  }
+
+  // The newest checkpoint of the directory at the same rank count resumes; another rank count,
+  // and a serial run's checkpoints under mpirun, are refused with the rank count to use.
+  TempDir dir("mpi_resume_refused");
+  fs::create_directories(dir.path);
+  std::ofstream(dir.path / "run.yaml") << disks(2, "linear");
+  REQUIRE(run_on(dir.path, "np2", 2, ck).exit_code == 0);
+  const auto newest = run_on(dir.path, "np2", 2, ck + " --resume " + (dir.path / "np2").string());
+  INFO(newest.output);
+  CHECK(newest.exit_code == 0);
+  const auto other = run_on(dir.path, "np2", 4, ck + " --resume " + (dir.path / "np2").string());
+  std::printf("resumed at 4 ranks from 2: exit %d\n%s", other.exit_code, other.output.c_str());
+  CHECK(other.exit_code == 2);
+  CHECK(other.output.find("written by a run on 2 rank(s)") != std::string::npos);
+  REQUIRE(run_on(dir.path, "serial", 0, ck).exit_code == 0);
+  const auto serial =
+      run_on(dir.path, "serial", 2, ck + " --resume " + (dir.path / "serial").string());
+  std::printf("serial checkpoints resumed at 2 ranks: exit %d\n%s", serial.exit_code,
+              serial.output.c_str());
+  CHECK(serial.exit_code == 2);
+  CHECK(serial.output.find("written by a run on 1 rank(s)") != std::string::npos);
+}
+
 TEST_CASE("mpirun: what does not run on ranks yet is refused with located errors, writing nothing",
           "[mpi][mpi_run][bad_config]") {
   // docs/parallel.md "What runs on ranks": a plugin that does not declare runs_on_ranks, and the

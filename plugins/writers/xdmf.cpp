@@ -57,6 +57,7 @@ class Xdmf : public Writer<D> {
                       {"attributes", attrs(f.attributes)},
                       {"grid_nodes", f.grid_nodes},
                       {"grid_attributes", attrs(f.grid_attributes)}});
+        if (!f.pieces.empty()) js.back()["pieces"] = f.pieces;
       }
       j.push_back(js);
     }
@@ -72,14 +73,9 @@ class Xdmf : public Writer<D> {
           for (const auto& x : a) as.push_back({x[0], x[1], x[2]});
           return as;
         };
-        frames_[s].push_back(Frame{f["file"],
-                                   f["time"],
-                                   f["step"],
-                                   f["n"],
-                                   attrs(f["attributes"]),
-                                   f["grid_nodes"],
-                                   attrs(f["grid_attributes"]),
-                                   {}});
+        frames_[s].push_back(Frame{f["file"], f["time"], f["step"], f["n"], attrs(f["attributes"]),
+                                   f["grid_nodes"], attrs(f["grid_attributes"]),
+                                   f.value("pieces", std::vector<long>{})});
       }
   }
 
@@ -129,7 +125,7 @@ class Xdmf : public Writer<D> {
     Frame fr;
     std::string error, failed_file;
     try {
-      fr = write_particles(sim, set, std::string(stem) + piece_tag(ranks.rank()) + ".h5");
+      fr = write_particles(sim, set, std::string(stem) + ranks.file_tag() + ".h5");
     } catch (const WriteError& e) {
       error = e.what(), failed_file = e.file;
     }
@@ -138,14 +134,6 @@ class Xdmf : public Writer<D> {
     if (!error.empty()) throw WriteError(failed_file, error);
     frames_[s].push_back(fr);
     if (ranks.root()) write_index(set.name, frames_[s], false);
-  }
-
-  /// What names a rank's piece of a frame: _rRRRR (its file <stem>_rRRRR.h5, its grid
-  /// <set>_rRRRR in the index).
-  static std::string piece_tag(int rank) {
-    char s[32];
-    std::snprintf(s, sizeof s, "_r%04d", rank);
-    return s;
   }
 
   /// This process's particles of a set as the HDF5 file `name` in the directory.
@@ -274,7 +262,7 @@ class Xdmf : public Writer<D> {
         << "CollectionType=\"Spatial\">\n        <Time Value=\"" << fr.time << "\"/>\n";
       for (size_t r = 0; r < fr.pieces.size(); ++r)
         if (fr.pieces[r] > 0)
-          polyvertex(x, set + piece_tag(int(r)), fr.file + piece_tag(int(r)) + ".h5", "",
+          polyvertex(x, set + rank_tag(int(r)), fr.file + rank_tag(int(r)) + ".h5", "",
                      size_t(fr.pieces[r]), fr.attributes, fr.time, true);
       x << "      </Grid>\n";
     }
