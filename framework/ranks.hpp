@@ -61,6 +61,16 @@ class Ranks {
     b.dims.fill(1);
     return b;
   }
+  /// Whether this rank owns grid node ijk (global indices): the lower corners of its cells,
+  /// and the last node row along an axis for the last block along it.
+  bool owns_node(const Grid<D>& grid, const std::array<int, D>& ijk) const {
+    const CellBlock b = cell_block(grid);
+    for (size_t d = 0; d < size_t(D); ++d) {
+      const int hi = b.coord[d] == b.dims[d] - 1 ? b.hi[d] + 1 : b.hi[d];
+      if (ijk[d] < b.lo[d] || ijk[d] >= hi) return false;
+    }
+    return true;
+  }
 
   /// Complete nodal sums over the ranks after a scatter: each ghost node's share is added into
   /// its owner (in a fixed neighbour order), and the owner's total copied back to every ghost
@@ -91,6 +101,8 @@ class Ranks {
   virtual std::string first_message(const std::string& mine) const { return mine; }
   /// Every rank's n, on rank 0 in rank order (empty on the others).
   virtual std::vector<long> gather(long n) const { return {n}; }
+  /// Every rank's values, concatenated in rank order, on rank 0 (empty on the others).
+  virtual std::vector<double> gather(const std::vector<double>& mine) const { return mine; }
   /// Every rank's values, concatenated in rank order, on every rank.
   virtual std::vector<double> all_gather(const std::vector<double>& mine) const { return mine; }
   virtual void barrier() const {}

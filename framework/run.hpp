@@ -84,7 +84,8 @@ struct Probe {
   bool on_node = false;
   int set = 0;
   uint32_t particle_id = 0;
-  size_t node = 0;
+  size_t node = 0;           // its index among this rank's stored nodes, if it samples it
+  bool samples_node = true;  // this rank owns the probe's node (every node serially)
   std::vector<std::string> fields;
   long every = 1;
   CsvFile csv;
@@ -166,6 +167,7 @@ class Run {
   double strain_magnitude(const Particles<D>& p, size_t i) const;
   void open_outputs(long resume_step = -1);
   void sample_probes(bool force);
+  bool take_probe_sample(const Probe<D>& pr, std::vector<double>& values) const;
   void write_history();
   bool exchanges_particles() const { return !sim_->sources.empty() || !sim_->sinks.empty(); }
   void write_frame(const std::string& label);

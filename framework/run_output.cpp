@@ -107,7 +107,10 @@ void Run<D>::check_outputs(Diagnostics& diag) {
         }
         node[size_t(d)] = int(std::max(0L, k));
       }
-      probe.node = sim_->grid.node_index(node);
+      // Under mpirun the rank that owns the node samples it (every copy of a node holds the
+      // whole grid's value, the owner's is the one its boundary conditions act on).
+      probe.samples_node = sim_->ranks->owns_node(sim_->grid, node);
+      if (probe.samples_node) probe.node = sim_->grid.node_index(node);
     } else {
       probe.set = sim_->set_param(pr, "set", diag);
       if (probe.set < 0) continue;
@@ -134,6 +137,12 @@ void Run<D>::check_outputs(Diagnostics& diag) {
       nearest(ps);
       for (size_t b = 0; b < sim_->bodies.size(); ++b)
         if (sim_->body_set(int(b)) == probe.set) nearest(sim_->waiting_particles(int(b)));
+      // Under mpirun, the nearest over the ranks; of equally near ones the lowest id, as the
+      // serial search (its candidates are in id order) finds.
+      const auto all = sim_->ranks->all_gather({best, double(probe.particle_id)});
+      for (size_t r = 0; r < all.size(); r += 2)
+        if (all[r] < best || (all[r] == best && all[r + 1] < double(probe.particle_id)))
+          best = all[r], probe.particle_id = uint32_t(all[r + 1]);
       if (best == 1e300) {
         diag.error(pr.where("set"), pr.path("set"), "the particle set has no particles");
         continue;
@@ -259,50 +268,77 @@ void Run<D>::open_outputs(long resume_step) {
   }
 }
 
+/// The probes due at this step (all with `force`): each probe's values are taken where its
+/// particle or node is (under mpirun on one rank), gathered on the first rank (one message per
+/// rank for all probes) and written there as one row per probe.
 template <int D>
 void Run<D>::sample_probes(bool force) {
-  for (auto& pr : probes_) {
-    if (!force && sim_->step % pr.every != 0) continue;
+  std::vector<size_t> due, widths;
+  std::vector<double> mine;  // per due probe: 1 if sampled here (else 0), then its values
+  for (size_t k = 0; k < probes_.size(); ++k)
+    if (force || sim_->step % probes_[k].every == 0) {
+      due.push_back(k);
+      const size_t at = mine.size();
+      mine.push_back(0.0);
+      const bool here = take_probe_sample(probes_[k], mine);
+      mine[at] = here ? 1.0 : 0.0;
+      widths.push_back(mine.size() - at - 1);
+    }
+  if (due.empty()) return;
+  const std::vector<double> all = sim_->ranks->gather(mine);
+  if (!sim_->ranks->root()) return;
+  for (size_t j = 0, at = 0; j < due.size(); at += 1 + widths[j], ++j) {
+    Probe<D>& pr = probes_[due[j]];
     auto& o = pr.csv.out();
     o << sim_->step << "," << sim_->time;
-    if (pr.on_node) {
-      for (const auto& f : pr.fields)
-        for (const auto& g : sim_->scheme->grid_fields())
-          if (g.name == f)
-            for (int c = 0; c < g.components; ++c)
-              o << "," << g.base[pr.node * size_t(g.stride) + size_t(g.offset + c)];
-    } else {
-      const ParticleSet<D>& set = sim_->sets[size_t(pr.set)];
-      const Particles<D>& p = set.particles;
-      const size_t i = set.index_of(pr.particle_id);
-      if (i == set.npos) {  // not in the run: its body waits for a stage, or a sink took it
-        for (const auto& f : pr.fields) {
-          const int n = f == "displacement"       ? D
-                        : f == "strain_magnitude" ? 1
-                                                  : p.info(p.find(f)).components;
-          for (int c = 0; c < n; ++c) o << ",nan";
-        }
-        o << "\n";
-        pr.csv.check();
-        continue;
+    size_t from = all.size();  // the first rank that sampled it
+    for (size_t r = 0; r < all.size(); r += mine.size())
+      if (all[r + at] != 0) {
+        from = r + at + 1;
+        break;
       }
-      for (const auto& f : pr.fields) {
-        if (f == "displacement") {
-          for (int d = 0; d < D; ++d)
-            o << "," << p.col(p.position, d)[i] - p.col(initial_position_, d)[i];
-          continue;
-        }
-        if (f == "strain_magnitude") {
-          o << "," << strain_magnitude(p, i);
-          continue;
-        }
-        int h = p.find(f);
-        for (int c = 0; c < p.info(h).components; ++c) o << "," << p.col(h, c)[i];
-      }
+    for (size_t c = 0; c < widths[j]; ++c) {
+      // Not in the run: its body waits for a stage, or a sink took it.
+      if (from == all.size())
+        o << ",nan";
+      else
+        o << "," << all[from + c];
     }
     o << "\n";
     pr.csv.check();
   }
+}
+
+/// Appends probe pr's values at this step to `values` (nan where this rank does not hold its
+/// particle or node); returns whether it holds it.
+template <int D>
+bool Run<D>::take_probe_sample(const Probe<D>& pr, std::vector<double>& values) const {
+  const double nan = std::nan("");
+  if (pr.on_node) {
+    for (const auto& f : pr.fields)
+      for (const auto& g : sim_->scheme->grid_fields())
+        if (g.name == f)
+          for (int c = 0; c < g.components; ++c)
+            values.push_back(
+                pr.samples_node ? g.base[pr.node * size_t(g.stride) + size_t(g.offset + c)] : nan);
+    return pr.samples_node;
+  }
+  const ParticleSet<D>& set = sim_->sets[size_t(pr.set)];
+  const Particles<D>& p = set.particles;
+  const size_t i = set.index_of(pr.particle_id);
+  const bool here = i != set.npos;
+  for (const auto& f : pr.fields) {
+    if (f == "displacement") {
+      for (int d = 0; d < D; ++d)
+        values.push_back(here ? p.col(p.position, d)[i] - p.col(initial_position_, d)[i] : nan);
+    } else if (f == "strain_magnitude") {
+      values.push_back(here ? strain_magnitude(p, i) : nan);
+    } else {
+      const int h = p.find(f);
+      for (int c = 0; c < p.info(h).components; ++c) values.push_back(here ? p.col(h, c)[i] : nan);
+    }
+  }
+  return here;
 }
 
 template <int D>

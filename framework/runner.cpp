@@ -558,15 +558,20 @@ RunResult Run<D>::loop() {
   const bool resuming = !resume_file_.empty();
   const bool files = opt_.write_output;
   // A file that cannot be written (WriteError, a failed rename) stops the run with exit 4.
+  // Serially the outputs after a failed one are skipped; under mpirun every rank still makes
+  // every output's collective calls (a frame's gather, the history's energies, the probes'
+  // gather), so that no rank waits for one that gave up; the ranks agree on the error after.
   std::string write_error;
+  const bool distributed = sim.ranks->distributed();
   auto guarded = [&](auto&& write) {
-    if (!write_error.empty()) return;
+    if (!write_error.empty() && !distributed) return;
     try {
       write();
     } catch (const WriteError& e) {
-      write_error = e.what();
+      if (write_error.empty()) write_error = e.what();
     } catch (const fs::filesystem_error& e) {
-      write_error = "cannot write " + e.path1().string() + ": " + e.code().message();
+      if (write_error.empty())
+        write_error = "cannot write " + e.path1().string() + ": " + e.code().message();
     }
   };
   if (resuming) {
@@ -597,7 +602,6 @@ RunResult Run<D>::loop() {
   int interrupted = 0;  // the signal that stopped the run (InterruptGuard)
   const bool keep_good_image = files && sim.keep_last_good && checkpointing();
   const int num_stages = int(sim.stages.size());
-  const bool distributed = sim.ranks->distributed();
   bool budget = false;           // --max-steps reached
   std::string stopped_by_stage;  // a stage that did not reach static (if_not_static: stop)
   bool within_stage = resuming;  // resumed within stage ls_.stage: it has begun already
@@ -674,26 +678,29 @@ RunResult Run<D>::loop() {
         last = last || reached_static;
       }
       if (sim.reference) sim.reference->sample(sim);
-      if (files)
-        guarded([&] {
-          sample_probes(last);
-          if (frame_due || last) {
+      if (files) {
+        guarded([&] { sample_probes(last); });
+        if (frame_due || last)
+          guarded([&] {
             write_frame("");
             ls_.frame_step = sim.step;
             while (every_time > 0 && ls_.next_frame_time <= sim.time * (1 + 1e-9))
               ls_.next_frame_time += every_time;
-          }
-          if ((history_every > 0 && sim.step % history_every == 0) ||
-              (history_every == 0 && (frame_due || last))) {
+          });
+        if ((history_every > 0 && sim.step % history_every == 0) ||
+            (history_every == 0 && (frame_due || last)))
+          guarded([&] {
             write_history();
             ls_.history_step = sim.step;
-          }
-          if (checkpoint_due && !last) {  // not of a stage's end (static is known after it)
+          });
+        if (checkpoint_due && !last)  // not of a stage's end (static is known after it)
+          guarded([&] {
             write_checkpoint(checkpoint_image());
             last_checkpoint = Clock::now();
-          }
-          if (keep_good_image && sim.last_good.step == sim.step) good_image_ = checkpoint_image();
-        });
+          });
+        if (keep_good_image && sim.last_good.step == sim.step)
+          guarded([&] { good_image_ = checkpoint_image(); });
+      }
       if (distributed) write_error = sim.ranks->first_message(write_error);
       if (!write_error.empty()) break;
       auto now = Clock::now();

@@ -220,7 +220,7 @@ void Simulation<D>::split_over_ranks(Diagnostics& diag) {
   const auto& lp = config.list("loads");
   for (size_t i = 0; i < loads.size() && i < lp.size(); ++i)
     refuse_plugin(loads[i]->runs_on_ranks(), lp[i]);
-  for (const char* key : {"sources", "sinks", "stages", "probes", "selections"})
+  for (const char* key : {"sources", "sinks", "stages", "selections"})
     if (!config.list(key).empty()) diag.error(config.where(key), key, "this key" + only);
   for (const char* key : {"verify", "strength_reduction"})
     if (config.given(key)) diag.error(config.where(key), key, "this key" + only);

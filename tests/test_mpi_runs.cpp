@@ -147,6 +147,18 @@ struct Scene {
 /// Two elastic disks (spheres, a bar's halves) meeting near the centre of the grid, each moving
 /// along the diagonal at another speed (the contact moves), so that their particles cross every
 /// cut between the blocks, the corners included; 200 steps.
+/// [x, y, y...] in dim dimensions.
+std::string point_at(int dim, double x, double y) {
+  std::string p = "[" + std::to_string(x);
+  for (int d = 1; d < dim; ++d) p += ", " + std::to_string(y);
+  return p + "]";
+}
+std::string node_at(int dim, int i, int j) {
+  std::string p = "[" + std::to_string(i);
+  for (int d = 1; d < dim; ++d) p += ", " + std::to_string(j);
+  return p + "]";
+}
+
 std::string disks(int dim, const std::string& shape,
                   const std::string& scheme = "{type: single_phase, update: musl}",
                   const std::string& time = "{end: 1.0, dt: 0.005}") {
@@ -177,7 +189,18 @@ std::string disks(int dim, const std::string& shape,
          (scheme.find("two_phase") != std::string::npos
               ? "[velocity, stress, mass, pore_pressure, water_velocity]"
               : "[velocity, stress, mass]") +
-         "}\n";
+         "}\n"
+         // The particles facing each other across the middle, and the middle node.
+         "probes:\n"
+         "  - {name: left_front, particle_near: " +
+         point_at(dim, 0.46, 0.27) +
+         ", fields: [position, velocity, stress, displacement]}\n"
+         "  - {name: right_front, particle_near: " +
+         point_at(dim, 0.54, 0.73) +
+         ", fields: [velocity, stress]}\n"
+         "  - {name: middle, node: " +
+         node_at(dim, int(std::lround(0.5 / cell)), int(std::lround(0.27 / cell))) +
+         ", fields: [mass, velocity]}\n";
 }
 
 /// A Mohr-Coulomb column collapsing along a friction floor past the cuts (granular collapse,
@@ -318,6 +341,25 @@ TEST_CASE("mpirun -np 1, 2 and 4: whole runs match the serial run, every shape f
       }
       const double field_error = difference.relative();
       const bool ids_match = difference.ids_match;
+      // Probes (disks: two particles, one node): every step's row, each column within 1e-10
+      // of its largest magnitude, as the frames' fields.
+      double probe_error = 0;
+      long probe_rows = 0;
+      for (const char* probe : {"left_front", "right_front", "middle"}) {
+        const fs::path csv = fs::path("probe_") += std::string(probe) + ".csv";
+        if (!fs::exists(dir.path / "serial" / csv)) continue;
+        const auto p0 = loam_test::read_csv_columns(dir.path / "serial" / csv);
+        const auto p = loam_test::read_csv_columns(dir.path / out / csv);
+        REQUIRE(p.at("step") == p0.at("step"));
+        for (const auto& [key, a] : p0) {
+          const auto& b = p.at(key);
+          double scale = 0;
+          for (double x : a) scale = std::max(scale, std::fabs(x));
+          for (size_t i = 0; i < a.size(); ++i)
+            probe_error = std::max(probe_error, std::fabs(a[i] - b[i]) / (scale > 0 ? scale : 1.0));
+        }
+        probe_rows += long(p0.at("step").size());
+      }
       // summary.json: the whole model's counts and masses, written by the first rank.
       const auto summary = nlohmann::json::parse(loam_test::slurp(dir.path / out / "summary.json"));
       const auto summary0 =
@@ -333,13 +375,15 @@ TEST_CASE("mpirun -np 1, 2 and 4: whole runs match the serial run, every shape f
                                               read_frame(dir.path / out, last, ranks));
       std::printf(
           "mpi run, %-26s -np %d: history (momentum, energies) %.2e, particle fields %.2e over "
-          "%zu frames, ids %s, %zu of %zu particles changed rank%s\n",
-          scene.name.c_str(), ranks, history_error, field_error, frame_ids.size(),
-          ids_match ? "match" : "DIFFER", moved.size(), first.count,
+          "%zu frames, probes %.2e over %ld rows, ids %s, %zu of %zu particles changed rank%s\n",
+          scene.name.c_str(), ranks, history_error, field_error, frame_ids.size(), probe_error,
+          probe_rows, ids_match ? "match" : "DIFFER", moved.size(), first.count,
           same_bits ? ", bitwise the serial run" : "");
       CHECK(ids_match);
       CHECK(history_error <= 1e-12);
       CHECK(field_error <= 1e-10);
+      CHECK(probe_error <= 1e-10);
+      if (scene.name.find("disks") != std::string::npos) CHECK(probe_rows > 0);
       if (ranks == 1) CHECK(same_bits);
       if (ranks > 1 && scene.name.find("Terzaghi") == std::string::npos) CHECK(!moved.empty());
     }
@@ -473,8 +517,7 @@ TEST_CASE("mpirun: what does not run on ranks yet is refused with located errors
                 {"run.yaml:2:17: error: shape_function: 'cpdi' does not run under mpirun yet",
                  "run.yaml:9:5: error: loads.0: 'point' does not run under mpirun yet",
                  "run.yaml:11:5: error: boundaries.0: 'fixed' does not run under mpirun yet",
-                 "run.yaml:12:5: error: boundaries.1: 'absorbing' does not run under mpirun yet",
-                 "run.yaml:15:3: error: probes: this key does not run under mpirun yet"});
+                 "run.yaml:12:5: error: boundaries.1: 'absorbing' does not run under mpirun yet"});
 
   // Four ranks on a grid of 3 cells along x: a gimp block needs 2 (its reach).
   std::ofstream(dir.path / "run.yaml")

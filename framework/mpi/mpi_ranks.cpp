@@ -106,6 +106,20 @@ std::vector<long> MpiRanks<D>::gather(long n) const {
 }
 
 template <int D>
+std::vector<double> MpiRanks<D>::gather(const std::vector<double>& mine) const {
+  const int n = int(mine.size());
+  const bool root = cart_.rank() == 0;
+  std::vector<int> counts(root ? size_t(cart_.size()) : 0), offsets(counts.size(), 0);
+  mpi_check(MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, cart_.comm()), "MPI_Gather");
+  for (size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<double> all(root ? size_t(offsets.back() + counts.back()) : 0);
+  mpi_check(MPI_Gatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
+                        MPI_DOUBLE, 0, cart_.comm()),
+            "MPI_Gatherv");
+  return all;
+}
+
+template <int D>
 std::vector<double> MpiRanks<D>::all_gather(const std::vector<double>& mine) const {
   const int n = int(mine.size());
   std::vector<int> counts(size_t(cart_.size())), offsets(size_t(cart_.size()), 0);

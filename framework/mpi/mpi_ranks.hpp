@@ -40,6 +40,7 @@ class MpiRanks : public Ranks<D> {
   void sum(double* values, int n) const override;
   std::string first_message(const std::string& mine) const override;
   std::vector<long> gather(long n) const override;
+  std::vector<double> gather(const std::vector<double>& mine) const override;
   std::vector<double> all_gather(const std::vector<double>& mine) const override;
   void barrier() const override;
 
