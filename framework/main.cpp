@@ -32,7 +32,9 @@ int main(int argc, char** argv) {
                   "checkpoint_*.h5) or one checkpoint file; the output goes on there");
   run->add_flag("--overwrite", run_opt.overwrite,
                 "replace the results in a non-empty output directory");
-  run->add_option("--threads", run_opt.threads, "OpenMP threads (default: all cores)")
+  run->add_option(
+         "--threads", run_opt.threads,
+         "OpenMP threads (default: OMP_NUM_THREADS, else all cores within a container's CPU quota)")
       ->check(CLI::Range(1, 1024));
   run->add_flag("--quiet", run_opt.quiet, "no progress lines");
 

@@ -3,7 +3,6 @@
 // output files are written in run_output.cpp; Run<D> is declared in run.hpp.
 #include "runner.hpp"
 
-#include <omp.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -15,6 +14,7 @@
 #include <sstream>
 
 #include "checkpoint.hpp"
+#include "cores.hpp"
 #include "interrupt.hpp"
 #include "run.hpp"
 #include "simulation.hpp"
@@ -97,7 +97,7 @@ template <int D>
 RunResult Run<D>::execute(bool check_only) {
   RunResult res;
   Diagnostics diag;
-  int threads = opt_.threads > 0 ? opt_.threads : omp_get_max_threads();
+  int threads = opt_.threads > 0 ? opt_.threads : default_threads();
   sim_ = std::make_unique<Simulation<D>>(cfg_.params, threads, diag);
   if (sim_->model_checked) check_outputs(diag);
   if (sim_->model_checked) check_strength_reduction(diag);
