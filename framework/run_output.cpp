@@ -344,6 +344,9 @@ bool Run<D>::take_probe_sample(const Probe<D>& pr, std::vector<double>& values) 
 template <int D>
 void Run<D>::write_history() {
   Energies e = sim_->energies();  // over all ranks: every rank calls this
+  // Particles and the mass created and removed so far, over the ranks.
+  double exchanged[3] = {double(sim_->num_particles()), sim_->mass_created, sim_->mass_removed};
+  if (exchanges_particles()) sim_->ranks->sum(exchanged, 3);
   if (!sim_->ranks->root()) return;
   auto& o = history_.out();
   double strain = std::isnan(e.strain) ? 0.0 : e.strain;
@@ -351,7 +354,7 @@ void Run<D>::write_history() {
     << "," << e.gravity << "," << e.kinetic + strain + e.gravity;
   for (double m : e.momentum) o << "," << m;
   if (exchanges_particles())
-    o << "," << sim_->num_particles() << "," << sim_->mass_created << "," << sim_->mass_removed;
+    o << "," << size_t(exchanged[0]) << "," << exchanged[1] << "," << exchanged[2];
   o << "\n";
   history_.check();
 }

@@ -535,10 +535,10 @@ nlohmann::json Run<D>::stage_record(const std::string& status) {
     r["static"] = status == "static";
     r["static_window"] = ls_.static_window;
   }
-  r["max_speed"] = sim.max_speed;
-  if (st.until_static) r["motion_speed"] = sim.motion_speed;
+  r["max_speed"] = sim.max_speed;  // over the ranks (Simulation::advance)
+  if (st.until_static) r["motion_speed"] = sim.motion_speed;  // over the ranks already
   // The largest displacement since the last reset (the output's displacement reference).
-  r["max_displacement"] = largest_displacement();
+  r["max_displacement"] = sim.ranks->max(largest_displacement());
   r["energy"] = energy_json(sim.energies());
   if (sim.reference) {
     nlohmann::json v = nlohmann::json::object();
@@ -744,9 +744,11 @@ RunResult Run<D>::loop() {
                       "particles slower than static_speed = {:.3g} m/s only since t = "
                       "{:.4g} s, less than static_window = {:.3g} s",
                       stage.static_speed, ls_.static_since, ls_.static_window);
-        spdlog::warn("stage {} '{}' did not reach static within max_time = {} s ({}){}", k + 1,
-                     stage.name, stage.duration, why,
-                     stage.stop_if_not_static ? ": the run stops here (if_not_static: stop)" : "");
+        if (sim.ranks->root())
+          spdlog::warn(
+              "stage {} '{}' did not reach static within max_time = {} s ({}){}", k + 1, stage.name,
+              stage.duration, why,
+              stage.stop_if_not_static ? ": the run stops here (if_not_static: stop)" : "");
       }
       if (status == "not_static" && stage.stop_if_not_static && k + 1 < num_stages)
         stopped_by_stage = stage.name;
@@ -800,17 +802,19 @@ RunResult Run<D>::loop() {
   if (sim.profiling) res.summary["profile_seconds"] = sim.profile;
   Energies e1 = sim.energies();
   // Sources and sinks: counts and the mass balance (round-off when nothing is lost).
-  double masses[2] = {sim.total_mass(), sim.initial_mass};  // now, initial: over the ranks
-  sim.ranks->sum(masses, 2);
-  const double mass_now = masses[0], mass_initial = masses[1];
-  res.summary["particles_created"] = sim.created;
-  res.summary["particles_removed"] = sim.removed;
-  res.summary["mass"] = {
-      {"initial", mass_initial},
-      {"final", mass_now},
-      {"created", sim.mass_created},
-      {"removed", sim.mass_removed},
-      {"balance", mass_now + sim.mass_removed - sim.mass_created - mass_initial}};
+  // Over the ranks: masses now and initial, particles and mass created and removed.
+  double sums[6] = {sim.total_mass(),    sim.initial_mass, double(sim.created),
+                    double(sim.removed), sim.mass_created, sim.mass_removed};
+  sim.ranks->sum(sums, 6);
+  const double mass_now = sums[0], mass_initial = sums[1], mass_created = sums[4],
+               mass_removed = sums[5];
+  res.summary["particles_created"] = size_t(sums[2]);
+  res.summary["particles_removed"] = size_t(sums[3]);
+  res.summary["mass"] = {{"initial", mass_initial},
+                         {"final", mass_now},
+                         {"created", mass_created},
+                         {"removed", mass_removed},
+                         {"balance", mass_now + mass_removed - mass_created - mass_initial}};
   res.summary["energy_initial"] = energy_json(ls_.e0);
   res.summary["energy_final"] = energy_json(e1);
   res.summary["verify"] = nlohmann::json::object();  // always there: empty without a reference

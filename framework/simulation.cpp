@@ -47,7 +47,16 @@ bool Simulation<D>::advance(double step_dt, bool check) {
   const bool distributed = ranks->distributed();
   if (distributed) failure = ranks->first_message(failure);  // one rank's failure stops all
   if (!failure.empty()) return false;
-  if (track) timed("motion", [&] { motion_speed = largest_move(dt); });
+  // The largest particle speed over the ranks: the time step's CFL bound is then the serial
+  // run's, cfl h / (max c + max |v|), as a MIN over the ranks of cfl h / (c_rank + max |v|);
+  // with each rank's own speed it would be cfl h / max (c_rank + v_rank), larger when the
+  // fastest wave and the fastest particle are on different ranks.
+  if (distributed) max_speed = ranks->max(max_speed);
+  if (track)
+    timed("motion", [&] {
+      motion_speed = largest_move(dt);
+      if (distributed) motion_speed = ranks->max(motion_speed);  // a stage's `until: static`
+    });
   exchange_particles();
   if (distributed) timed("migration", [&] { migrate_particles(); });
   // Check before sorting: the sort must not see non-finite positions. Under mpirun every rank

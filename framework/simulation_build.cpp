@@ -130,7 +130,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
       const double* v = s.particles.col(s.particles.velocity, d);
       for (size_t i = 0; i < s.size(); ++i) v2 = std::max(v2, v[i] * v[i]);
     }
-  max_speed = std::sqrt(v2);
+  max_speed = ranks->max(std::sqrt(v2));  // over the ranks, as after every step (advance)
   // Step budget: a stiff set-up (e.g. K_w / n with a porosity near 0) can make the stable time
   // step so small that the run would never finish; say so before writing anything.
   const double dt0 = stable_dt();
@@ -220,7 +220,20 @@ void Simulation<D>::split_over_ranks(Diagnostics& diag) {
   const auto& lp = config.list("loads");
   for (size_t i = 0; i < loads.size() && i < lp.size(); ++i)
     refuse_plugin(loads[i]->runs_on_ranks(), lp[i]);
-  for (const char* key : {"sources", "sinks", "stages", "selections"})
+  // A stage's own loads, boundaries and damping (swapped in when it begins).
+  const auto& sp = config.list("stages");
+  for (size_t k = 0; k < stages.size() && k < sp.size(); ++k) {
+    const Stage<D>& st = stages[k];
+    const auto& slp = sp[k].list("loads");
+    for (size_t i = 0; st.sets_loads && i < st.loads.size() && i < slp.size(); ++i)
+      refuse_plugin(st.loads[i]->runs_on_ranks(), slp[i]);
+    const auto& sbp = sp[k].list("boundaries");
+    for (size_t i = 0; st.sets_boundaries && i < st.boundaries.size() && i < sbp.size(); ++i)
+      refuse_plugin(st.boundaries[i]->runs_on_ranks(), sbp[i]);
+    if (st.sets_damping && st.damping && sp[k].given("damping"))
+      refuse_plugin(st.damping->runs_on_ranks(), sp[k].section("damping"));
+  }
+  for (const char* key : {"sources", "sinks", "selections"})
     if (!config.list(key).empty()) diag.error(config.where(key), key, "this key" + only);
   for (const char* key : {"verify", "strength_reduction"})
     if (config.given(key)) diag.error(config.where(key), key, "this key" + only);

@@ -233,7 +233,7 @@ void Simulation<D>::begin_stage(int k) {
     if (st.reset_displacement) restart_displacement(P, 0, P.size());
   }
   if (st.reset_velocity) max_speed = 0;
-  if (!st.params.path().empty())
+  if (!st.params.path().empty() && ranks->root())
     spdlog::info("stage {} '{}' begins at t = {:.6g} s", k + 1, st.name, time);
 }
 

@@ -90,7 +90,8 @@ double Run<D>::default_static_window() const {
   double longest = 0;
   for (int d = 0; d < D; ++d)
     longest = std::max(longest, sim.grid.upper_corner()[size_t(d)] - sim.grid.origin[size_t(d)]);
-  return longest / std::max(sim.wave_speed(), 1e-300);
+  // Under mpirun the fastest wave over the ranks (a rank may hold no particle yet).
+  return longest / std::max(sim.ranks->max(sim.wave_speed()), 1e-300);
 }
 
 /// One trial from the static state (in sim.last_good on entry): its record, status "static",
