@@ -43,6 +43,9 @@ class Reference {
   /// it is refused (a silently lost state would break the resumed run's results).
   virtual bool save_state(std::vector<double>&) const { return false; }
   virtual void restore_state(const std::vector<double>&) {}
+  /// Whether its metrics are over all ranks under mpirun (docs/parallel.md): each rank calls
+  /// metrics() and sample() with its own particles, and the plugin reduces over sim.ranks.
+  virtual bool runs_on_ranks() const { return false; }
 };
 
 }  // namespace loam

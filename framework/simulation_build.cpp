@@ -235,8 +235,10 @@ void Simulation<D>::split_over_ranks(Diagnostics& diag) {
   }
   for (const char* key : {"sources", "sinks", "selections"})
     if (!config.list(key).empty()) diag.error(config.where(key), key, "this key" + only);
-  for (const char* key : {"verify", "strength_reduction"})
-    if (config.given(key)) diag.error(config.where(key), key, "this key" + only);
+  if (reference && config.given("verify"))
+    refuse_plugin(reference->runs_on_ranks(), config.section("verify"));
+  if (config.given("strength_reduction"))
+    diag.error(config.where("strength_reduction"), "strength_reduction", "this key" + only);
   if (!shape || !diag.ok()) return;
   const std::string why = ranks->decompose(grid, shape->rows_below(), shape->rows_above(), threads);
   if (!why.empty()) diag.error(config.section("grid").where(), "grid", why);

@@ -225,7 +225,8 @@ std::string column(const std::string& shape) {
          "damping: {type: local, alpha: 0.05}\n"
          "time: {end: 0.25, dt: 5.0e-4}\n"
          "output: {every_steps: 100, history_every: 1, history_digits: 17, fields: [velocity, "
-         "stress, mass]}\n";
+         "stress, mass]}\n"
+         "verify: {type: granular_collapse}\n";
 }
 
 /// configs/construction_column_1d.yaml undamped, each stage at most 0.06 s (then the next).
@@ -421,6 +422,16 @@ TEST_CASE("mpirun -np 1, 2 and 4: whole runs match the serial run, every shape f
       for (const char* key : {"initial", "final", "created", "removed"})
         CHECK(std::fabs(summary["mass"][key].get<double>() - summary0["mass"][key].get<double>()) <=
               1e-12 * mass);
+      // The reference's metrics (the columns: run-out, final height, largest speed), over
+      // the ranks.
+      for (const auto& [key, value] : summary0["verify"].items()) {
+        if (!value.is_number()) continue;
+        INFO("verify." << key);
+        const double a = value.get<double>(), b = summary["verify"][key].get<double>();
+        CHECK(std::fabs(a - b) <= 1e-10 * std::max(1.0, std::fabs(a)));
+      }
+      if (scene.name.find("column collapse") != std::string::npos)
+        CHECK(summary0["verify"].contains("runout"));
       CHECK(std::fabs(summary["energy_final"]["kinetic"].get<double>() -
                       summary0["energy_final"]["kinetic"].get<double>()) <= 1e-12 * energy_scale);
       const long last = frame_ids.back();

@@ -56,6 +56,9 @@ class GranularCollapse : public Reference<D> {
       for (int d = 0; d < D; ++d) s += std::pow(P.col(P.velocity, d)[i], 2);
       v2 = std::max(v2, s);
     }
+    front = sim.ranks->max(front);  // over the ranks (identity serially)
+    top = sim.ranks->max(top);
+    v2 = sim.ranks->max(v2);
     const double a = H0_ / L0_;
     std::map<std::string, double> m;
     m["aspect_ratio"] = a;
@@ -73,6 +76,8 @@ class GranularCollapse : public Reference<D> {
 
   /// Checkpoints: nothing accumulates; everything is the set-up's or the final state's.
   bool save_state(std::vector<double>&) const override { return true; }
+  /// The front, the top and the largest speed are maxima over the ranks.
+  bool runs_on_ranks() const override { return true; }
 
  private:
   static double lube_runout(double a) {
