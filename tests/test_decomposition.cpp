@@ -11,10 +11,14 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <memory>
+#include <string>
 #include <tuple>
 
 #include "decomposition_scene.hpp"
 #include "framework/body_lattice.hpp"
+#include "framework/config.hpp"
+#include "framework/registry.hpp"
 
 namespace {
 
@@ -277,30 +281,26 @@ TEST_CASE("decomposition: cell links cover the ring of cells around each block a
 
 namespace {
 
-/// A ball that records every point it is asked about.
+/// A generator that records every point it is asked about, around a registered one.
 template <int D>
-struct RecordingBall : loam::Generator<D> {
-  std::array<double, D> centre{};
-  double radius = 0;
+struct Recording : loam::Generator<D> {
+  std::unique_ptr<loam::Generator<D>> region;
   mutable std::vector<std::array<double, D>> asked;
   bool contains(const std::array<double, D>& x) const override {
     asked.push_back(x);
-    double r2 = 0;
-    for (int d = 0; d < D; ++d)
-      r2 += (x[size_t(d)] - centre[size_t(d)]) * (x[size_t(d)] - centre[size_t(d)]);
-    return r2 <= radius * radius;
+    return region->contains(x);
   }
-  std::array<double, D> lower() const override {
-    auto lo = centre;
-    for (auto& v : lo) v -= radius;
-    return lo;
-  }
-  std::array<double, D> upper() const override {
-    auto hi = centre;
-    for (auto& v : hi) v += radius;
-    return hi;
-  }
+  std::array<double, D> lower() const override { return region->lower(); }
+  std::array<double, D> upper() const override { return region->upper(); }
 };
+
+/// [v_0, ..., v_D-1] as YAML.
+template <int D>
+std::string yaml_point(const std::array<double, D>& v) {
+  std::string t = "[";
+  for (size_t d = 0; d < size_t(D); ++d) t += (d ? ", " : "") + std::to_string(v[d]);
+  return t + "]";
+}
 
 /// One block of a rank array, with the sum over the ranks played by `sum_over_ranks`.
 template <int D>
@@ -319,10 +319,24 @@ void check_body_lattice(const std::array<int, D>& cells, const std::array<int, D
   std::array<double, D> origin{}, extent{}, h{};
   for (int d = 0; d < D; ++d) extent[size_t(d)] = cells[size_t(d)], h[size_t(d)] = 1.0;
   g.init(origin, extent, h);
-  RecordingBall<D> ball;
-  // A ball inside the grid (as the build requires of every body), off-centre.
-  ball.radius = 0.4 * double(*std::min_element(cells.begin(), cells.end()));
-  for (size_t d = 0; d < size_t(D); ++d) ball.centre[d] = 0.45 * double(cells[d]);
+  // The `sphere` generator: a ball inside the grid (as the build requires of every body),
+  // off-centre.
+  std::array<double, D> centre{}, upper{};
+  for (size_t d = 0; d < size_t(D); ++d)
+    centre[d] = 0.45 * double(cells[d]), upper[d] = double(cells[d]);
+  const double radius = 0.4 * double(*std::min_element(cells.begin(), cells.end()));
+  loam::Diagnostics diag;
+  const loam::LoadedConfig cfg = loam::load_config_text(
+      "grid: {origin: " + yaml_point<D>(origin) + ", extent: " + yaml_point<D>(upper) +
+          ", cell_size: 1}\nbodies:\n  - name: ball\n    generator: {type: sphere, center: " +
+          yaml_point<D>(centre) + ", radius: " + std::to_string(radius) +
+          "}\n    material: {type: linear_elastic, E: 1, nu: 0, density: 1}\ntime: {end: 1}\n",
+      "<test>", {}, diag);
+  INFO(diag.format());
+  REQUIRE(diag.ok());
+  Recording<D> ball;
+  ball.region = loam::Registry::instance().create<loam::Generator, D>(
+      cfg.params.list("bodies")[0].section("generator"));
   std::array<double, D> s{};
   std::array<long, D> i0{}, i1{};
   for (size_t d = 0; d < size_t(D); ++d) {
