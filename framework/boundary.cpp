@@ -1,5 +1,8 @@
 #include "boundary.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "diagnostics.hpp"
 #include "params.hpp"
 
@@ -98,18 +101,28 @@ void add_face_or_box_params(Schema& s, bool face_required_otherwise) {
 
 template <int D>
 std::vector<size_t> box_nodes(const Grid<D>& g, const Params& p, Diagnostics& diag) {
-  std::vector<size_t> out;
+  auto inside = [&](double x, int d) {
+    const double tol = 1e-9 * g.cell[size_t(d)];
+    return x >= p.vec("min")[size_t(d)] - tol && x <= p.vec("max")[size_t(d)] + tol;
+  };
+  // Whether the whole grid has a node in the box: per axis, the node rows nearest the box's
+  // ends. Under mpirun a rank's stored box may hold none of its nodes; that is no error.
+  for (int d = 0; d < D; ++d) {
+    const double o = g.origin[size_t(d)], h = g.cell[size_t(d)];
+    const int lo = std::clamp(int(std::ceil((p.vec("min")[size_t(d)] - o) / h - 1e-9)), 0,
+                              g.nodes[size_t(d)] - 1);
+    if (!inside(o + lo * h, d)) {
+      diag.error(p.where("min"), p.path("min"),
+                 "the box holds no grid node (a structure must span at least one node)");
+      return {};
+    }
+  }
+  std::vector<size_t> out;  // the stored nodes in the box
   for (size_t n = 0; n < g.num_nodes; ++n) {
     bool in = true;
-    for (int d = 0; d < D; ++d) {
-      const double x = g.node_coord(n, d), tol = 1e-9 * g.cell[size_t(d)];
-      in = in && x >= p.vec("min")[size_t(d)] - tol && x <= p.vec("max")[size_t(d)] + tol;
-    }
+    for (int d = 0; d < D; ++d) in = in && inside(g.node_coord(n, d), d);
     if (in) out.push_back(n);
   }
-  if (out.empty())
-    diag.error(p.where("min"), p.path("min"),
-               "the box holds no grid node (a structure must span at least one node)");
   return out;
 }
 

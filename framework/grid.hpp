@@ -48,6 +48,12 @@ struct Grid {
       num_nodes *= size_t(box_nodes[d]);
     }
   }
+  /// Whether the node with global indices ijk is in the stored box (always serially).
+  bool stores(const std::array<int, D>& ijk) const {
+    for (int d = 0; d < D; ++d)
+      if (ijk[d] < node_lo[d] || ijk[d] >= node_lo[d] + box_nodes[d]) return false;
+    return true;
+  }
   /// Index of the stored node with global indices ijk (inside the box).
   size_t node_index(const std::array<int, D>& ijk) const {
     size_t n = 0;

@@ -95,6 +95,8 @@ class Ranks {
   virtual double min(double v) const { return v; }
   virtual double max(double v) const { return v; }
   virtual void sum(double* /*values*/, int /*n*/) const {}
+  /// Element-wise maxima of n values over the ranks, in place.
+  virtual void max(double* /*values*/, int /*n*/) const {}
   virtual int max(int v) const { return v; }
   /// The message of the lowest rank whose message is not empty, on every rank ("" if none):
   /// a failure one rank finds stops every rank, with the same words.

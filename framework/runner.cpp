@@ -770,7 +770,10 @@ RunResult Run<D>::loop() {
           sim.swap_last_good();
           std::swap(sim.last_good, srf_mechanism_);
         });
-      if (srf["status"] == "interrupted") interrupted = InterruptGuard::requested();
+      if (srf["status"] == "interrupted") {
+        interrupted = InterruptGuard::requested();
+        if (distributed) interrupted = sim.ranks->max(interrupted);
+      }
     } else {
       srf = {{"status", "not_run"},
              {"reason", "the stages did not end in a static state (see stages[])"}};
@@ -825,7 +828,8 @@ RunResult Run<D>::loop() {
     const auto series = sim.reference->series();
     for (const auto& [name, values] : series) v["series"][name] = values;
     res.summary["verify"] = v;
-    if (files && !series.empty()) guarded([&] { write_series_csv(dir_ / "verify.csv", series); });
+    if (files && !series.empty() && sim.ranks->root())  // the series are over all ranks
+      guarded([&] { write_series_csv(dir_ / "verify.csv", series); });
   }
   if (!cfg_.params.list("stages").empty()) {
     nlohmann::json records = stage_records_;

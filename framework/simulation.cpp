@@ -37,6 +37,7 @@ bool Simulation<D>::advance(double step_dt, bool check) {
   dt = step_dt;
   prepare_particle_loads();
   shape->begin_step(*this);
+  if (ranks->distributed()) failure = ranks->first_message(failure);  // one rank's stops all
   if (!failure.empty()) return false;
   const bool checked = check || (step + 1) % check_every == 0;
   const bool track = checked && track_motion;
@@ -190,16 +191,31 @@ void Simulation<D>::add_particles(int b, const std::vector<Vec>& x, const Vec& v
   const Body& body = bodies[size_t(b)];
   ParticleSet<D>& set = sets[size_t(body.set)];
   Particles<D>& P = set.particles;
-  const size_t begin = P.size(), end = begin + x.size();
+  std::vector<size_t> kept;  // the points of x this rank keeps: all serially
+  kept.reserve(x.size());
+  const auto block = ranks->cell_block(grid);
+  for (size_t k = 0; k < x.size(); ++k) {
+    bool own = true;
+    for (int d = 0; d < D && own; ++d) {
+      const int c = grid.cell_of(x[k][size_t(d)], d);
+      own = c >= block.lo[size_t(d)] && c < block.hi[size_t(d)];
+    }
+    if (own) kept.push_back(k);
+  }
+  const uint32_t first = next_id_;
+  next_id_ += uint32_t(x.size());
+  if (kept.empty()) return;
+  const size_t begin = P.size(), end = begin + kept.size();
   P.resize(end);
   double vol = 1;
   for (int d = 0; d < D; ++d) vol *= body.spacing[size_t(d)];
   for (size_t i = begin; i < end; ++i) {
-    P.id[i] = next_id_++;
+    const size_t k = kept[i - begin];
+    P.id[i] = first + uint32_t(k);
     P.material[i] = uint16_t(b);
     P.body[i] = uint16_t(b);
     for (int d = 0; d < D; ++d) {
-      P.col(P.position, d)[i] = x[i - begin][size_t(d)];
+      P.col(P.position, d)[i] = x[k][size_t(d)];
       P.col(P.velocity, d)[i] = v[size_t(d)];
     }
     P.col(P.volume)[i] = vol;
@@ -211,7 +227,7 @@ void Simulation<D>::add_particles(int b, const std::vector<Vec>& x, const Vec& v
   materials[size_t(b)]->initialize(P, begin, end);
   restart_displacement(P, begin, end);
   for (size_t i = begin; i < end; ++i) mass_created += P.col(P.mass)[i];
-  created += x.size();
+  created += kept.size();
   set.invalidate_index();
   set.resized = true;
 }

@@ -260,6 +260,9 @@ class Simulation {
   /// (never reused), initialised like the particles generated at t = 0 (volume and mass from the
   /// body's spacing and density, then the shape function's, the scheme's and the material's
   /// initialisation); counted in mass_created. The set is re-sorted before the next scatter.
+  /// Under mpirun every rank passes the same x (a source decides from its own state and from
+  /// reductions over the ranks): each keeps the points of its own cells, and the k-th point of
+  /// x gets the id next + k on whichever rank keeps it, as serially.
   void add_particles(int body, const std::vector<Vec>& x, const Vec& v);
   /// The id the next created particle gets (checkpoints keep it).
   uint32_t& next_particle_id() { return next_id_; }
@@ -289,6 +292,16 @@ class Simulation {
   double stable_dt() const;
   /// The largest P-wave speed of the particles' materials (m/s), as the CFL step uses it.
   double wave_speed() const;
+  /// Material m's wave speed over the particles of `set` (0 if it has none), over all ranks
+  /// (MAX): a material's speed may depend on its particles (the lowest density), and a scheme
+  /// that scales it per particle (the two-phase fast wave) must see the whole model's. Every
+  /// rank calls it, in the same order.
+  double material_wave_speed(const ParticleSet<D>& set, size_t m) const {
+    const auto& r = set.partition.material_ranges[m];
+    const double c =
+        r.end > r.begin ? materials[m]->wave_speed(set.particles, r.begin, r.end) : 0.0;
+    return ranks->distributed() ? ranks->max(c) : c;
+  }
   long checked_step = -1;  // the last step whose particles passed the stability check
   /// With track_motion (a stage until: static), each checked step also measures how fast the
   /// particles actually move: motion_speed = max |x^{n+1} - x^n| / dt over every set. Under FLIP

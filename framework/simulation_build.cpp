@@ -94,7 +94,6 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
       if (r.end > r.begin) materials[m]->initialize(s.particles, r.begin, r.end);
     }
   if (particles_ok) scheme->initial_state(*this);
-  const size_t generated = num_particles();
   // Loads select their particles on the model as generated, the bodies that wait for a stage
   // included (the tailings on a dam raise that a later stage activates); when applied they skip
   // the particles not in the run.
@@ -120,7 +119,6 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   if (!diag.ok()) return;
   // The sources act at t = 0 too (an inlet starts filled); their particles count as created.
   initial_mass = total_mass();
-  next_id_ = uint32_t(generated);  // inactive bodies' particles have their ids already
   for (auto& p : sources) p->apply(*this, time);
   for (auto& s : sets)
     if (s.resized) sort(s);
@@ -210,35 +208,32 @@ void Simulation<D>::split_over_ranks(Diagnostics& diag) {
   auto refuse_plugin = [&](bool runs, const Params& p) {
     if (!runs) diag.error(p.where(), p.path(), "'" + p.type() + "'" + only);
   };
+  // The i-th plugin of a list against the i-th entry of its key (when `given`).
+  auto refuse_each = [&](const auto& plugins, const auto& entries, bool given = true) {
+    for (size_t i = 0; given && i < plugins.size() && i < entries.size(); ++i)
+      refuse_plugin(plugins[i]->runs_on_ranks(), entries[i]);
+  };
   if (scheme) refuse_plugin(scheme->runs_on_ranks(), config.section("scheme"));
   if (shape) refuse_plugin(shape->runs_on_ranks(), config.section("shape_function"));
   if (damping && config.given("damping"))
     refuse_plugin(damping->runs_on_ranks(), config.section("damping"));
-  const auto& bp = config.list("boundaries");
-  for (size_t i = 0; i < boundaries.size() && i < bp.size(); ++i)
-    refuse_plugin(boundaries[i]->runs_on_ranks(), bp[i]);
-  const auto& lp = config.list("loads");
-  for (size_t i = 0; i < loads.size() && i < lp.size(); ++i)
-    refuse_plugin(loads[i]->runs_on_ranks(), lp[i]);
+  refuse_each(boundaries, config.list("boundaries"));
+  refuse_each(loads, config.list("loads"));
+  refuse_each(sources, config.list("sources"));
+  refuse_each(sinks, config.list("sinks"));
   // A stage's own loads, boundaries and damping (swapped in when it begins).
   const auto& sp = config.list("stages");
   for (size_t k = 0; k < stages.size() && k < sp.size(); ++k) {
     const Stage<D>& st = stages[k];
-    const auto& slp = sp[k].list("loads");
-    for (size_t i = 0; st.sets_loads && i < st.loads.size() && i < slp.size(); ++i)
-      refuse_plugin(st.loads[i]->runs_on_ranks(), slp[i]);
-    const auto& sbp = sp[k].list("boundaries");
-    for (size_t i = 0; st.sets_boundaries && i < st.boundaries.size() && i < sbp.size(); ++i)
-      refuse_plugin(st.boundaries[i]->runs_on_ranks(), sbp[i]);
+    refuse_each(st.loads, sp[k].list("loads"), st.sets_loads);
+    refuse_each(st.boundaries, sp[k].list("boundaries"), st.sets_boundaries);
     if (st.sets_damping && st.damping && sp[k].given("damping"))
       refuse_plugin(st.damping->runs_on_ranks(), sp[k].section("damping"));
   }
-  for (const char* key : {"sources", "sinks", "selections"})
-    if (!config.list(key).empty()) diag.error(config.where(key), key, "this key" + only);
+  if (!config.list("selections").empty())
+    diag.error(config.where("selections"), "selections", "this key" + only);
   if (reference && config.given("verify"))
     refuse_plugin(reference->runs_on_ranks(), config.section("verify"));
-  if (config.given("strength_reduction"))
-    diag.error(config.where("strength_reduction"), "strength_reduction", "this key" + only);
   if (!shape || !diag.ok()) return;
   const std::string why = ranks->decompose(grid, shape->rows_below(), shape->rows_above(), threads);
   if (!why.empty()) diag.error(config.section("grid").where(), "grid", why);
@@ -327,6 +322,9 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
     diag.error(config.where("bodies"), "bodies", "more than 2^32 particles");
     return;
   }
+  // A source's particles are numbered after every generated one (those of the bodies that wait
+  // for a stage included), over all ranks.
+  next_id_ = uint32_t(next_id);
   // Each set holds its bodies' particles in body order; ids count over all bodies.
   for (auto& body : bodies) body.set = body_set_[size_t(&body - bodies.data())];
   for (size_t si = 0; si < sets.size(); ++si) {

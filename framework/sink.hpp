@@ -29,6 +29,9 @@ class Sink {
   /// Whether it would remove particles somewhere in the box [lower, upper] (a source's region).
   virtual bool overlaps(const std::array<double, D>& lower,
                         const std::array<double, D>& upper) const = 0;
+  /// Whether it runs on a grid split over MPI ranks (docs/parallel.md): it marks each particle
+  /// from that particle alone (its rank's particles are all it sees).
+  virtual bool runs_on_ranks() const { return false; }
 };
 
 /// A sink that acts on every set or on the one its `set` key names.

@@ -22,6 +22,10 @@ class Source {
   virtual void apply(Simulation<D>&, double t) = 0;
   /// The box where it creates particles (for the check that no sink removes them there).
   virtual void region(std::array<double, D>& lower, std::array<double, D>& upper) const = 0;
+  /// Whether it runs on a grid split over MPI ranks (docs/parallel.md): every rank passes the
+  /// same points to Simulation::add_particles (which keeps each rank's own), so what it creates
+  /// may depend only on its own state, the time and reductions over the ranks.
+  virtual bool runs_on_ranks() const { return false; }
   /// Checkpoints (output.checkpoint): the plugin's accumulated state as doubles, restored
   /// bit for bit on --resume. false: it has none implemented yet, and a checkpointed run with
   /// it is refused (a silently lost state would break the resumed run's results).

@@ -81,7 +81,7 @@ double Run<D>::largest_displacement() const {
       u2 = std::max(u2, a);
     }
   }
-  return std::sqrt(u2);
+  return sim_->ranks->max(std::sqrt(u2));  // over the ranks: every rank calls it
 }
 
 template <int D>
@@ -123,7 +123,9 @@ nlohmann::json Run<D>::srf_trial(const typename Simulation<D>::GoodState& start,
       status = "unstable";
       break;
     }
-    if (InterruptGuard::requested()) {
+    int signal = InterruptGuard::requested();
+    if (sim.ranks->distributed()) signal = sim.ranks->max(signal);  // every rank stops together
+    if (signal != 0) {
       status = "interrupted";
       break;
     }
@@ -148,7 +150,7 @@ nlohmann::json Run<D>::srf_trial(const typename Simulation<D>::GoodState& start,
       {"wall_seconds",
        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count()}};
   if (status == "unstable") rec["failure"] = sim.failure;
-  if (!opt_.quiet)
+  if (!opt_.quiet && sim.ranks->root())
     spdlog::info(
         "strength reduction F = {:.5g}: {} after {:.4g} s ({} steps), largest "
         "displacement {:.3g} m",
@@ -220,7 +222,7 @@ nlohmann::json Run<D>::strength_reduction() {
   } else if (status == "above_bracket") {
     out["factor_of_safety_bracket"] = {hi, nullptr};
   }
-  if (!opt_.quiet && status == "converged")
+  if (!opt_.quiet && sim.ranks->root() && status == "converged")
     spdlog::info("factor of safety {:.4g} (bracket [{:.5g}, {:.5g}], {} trials)", 0.5 * (lo + hi),
                  lo, hi, trials.size());
   return out;

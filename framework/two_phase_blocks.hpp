@@ -131,8 +131,7 @@ double max_fast_wave_speed2(const Simulation<D>& sim, const ParticleSet<D>& set,
   double c2 = 0;
   for (size_t m = 0; m < sim.materials.size(); ++m) {
     const auto& r = set.partition.material_ranges[m];
-    if (r.end <= r.begin) continue;
-    const double cd = sim.materials[m]->wave_speed(P, r.begin, r.end);
+    const double cd = sim.material_wave_speed(set, m);  // over the ranks: every rank calls it
     for (size_t i = r.begin; i < r.end; ++i) {
       const double rho_d = P.col(P.mass)[i] / P.col(P.volume)[i];  // (1 - n) rho_s
       c2 = std::max(c2, fast_wave_speed2(cd * cd * rho_d, P.col(porosity)[i], rho_d, Kw, rho_w));

@@ -235,18 +235,25 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   double stable_dt(const Simulation<D>& sim) const override {
     // The fast wave of the drag-free phases with each liquid material's own water (K_w =
     // rho_w c^2 from its wave speed); dry: the materials' CFL alone.
-    const auto& L = sim.sets[kLiquid];
+    // Under mpirun each liquid material's wave speed is the largest over the ranks: a rank's
+    // solid points feel the water of the whole model, also where this rank holds none of it.
     double c2 = 0;
     for (size_t m = 0; m < sim.materials.size(); ++m) {
-      const auto& r = L.partition.material_ranges[m];
-      if (r.end <= r.begin) continue;
-      const double c = sim.materials[m]->wave_speed(L.particles, r.begin, r.end);
+      const double c = sim.material_wave_speed(sim.sets[kLiquid], m);
+      if (!(c > 0)) continue;
       const double rho = sim.materials[m]->density();
       c2 = std::max(c2, max_fast_wave_speed2(sim, sim.sets[kSolid], n_, rho * c * c, rho));
     }
     if (!(c2 > 0)) return std::numeric_limits<double>::infinity();
     return sim.cfl * sim.grid.min_cell() / (std::sqrt(c2) + sim.max_speed);
   }
+
+  /// Both sets' nodal record and the re-map completed over the ranks after their scatters, the
+  /// cells' solid volumes after the scatter (the free-surface test reads them in the cell a
+  /// liquid point moved to, which may be in the ghost layer) and the liquid cell sums after the
+  /// move. The sums a liquid point reads in its own cell at the step's start (solid volume,
+  /// liquid volume) are whole on the rank owning the cell: every particle is there.
+  bool runs_on_ranks() const override { return true; }
 
   std::vector<GridFieldView> grid_fields() const override {
     return {{"mass", 1, node_.data(), S, kMs},
@@ -416,6 +423,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
           scatter_liquid<NPP>(sim, s, b, c, t);
       });
     });
+    sim.complete_nodes({{node_.data(), S, S}});
+    sim.complete_cells(cell_solid_, 1);
     sim.timed("grid", [&] { integrate(sim, dt); });
     reset_max_speed(scratch_);
     sim.timed("grid", [&] { zero_nodes(remap_, sim.threads); });
@@ -424,6 +433,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         remap<NPP>(sim, s, &s == &sim.sets[kSolid] ? kSolid : kLiquid, dt, b, c, t);
       });
     });
+    sim.complete_nodes({{remap_.data(), 2 * D, 2 * D}});
     sim.timed("grid", [&] { remapped_velocities(sim); });
     sim.timed("g2p_gradient_stress", [&] {
       sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
@@ -896,6 +906,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   void liquid_cells(Simulation<D>& sim) {
     Particles<D>& P = sim.sets[kLiquid].particles;
     liquid_cell_sums(sim, cell_index_, cell_, true);
+    sim.complete_cells(cell_, 2);  // a cell's points may be on two ranks before migration
     const double* m = P.col(P.mass);
     double* V = P.col(P.volume);
     const long np = long(P.size());

@@ -91,6 +91,9 @@ class Cpdi : public ShapeFunction<D> {
   int max_nodes_per_particle() const override { return 1 << (2 * D); }
   int rows_below() const override { return reach_; }
   int rows_above() const override { return reach_ + 1; }
+  /// Under mpirun the ghost layer is fixed when the grid is split (one row below, two above, as
+  /// gimp's): every step checks that no domain has grown beyond it (check_ghost_layer).
+  bool runs_on_ranks() const override { return true; }
 
   void setup(Simulation<D>& sim, Diagnostics&) override {
     F_ = sim.request_deformation_gradient();
@@ -119,6 +122,7 @@ class Cpdi : public ShapeFunction<D> {
   void begin_step(Simulation<D>& sim) override {
     const int old_reach = reach_;
     update_domains(sim, sim.failure);
+    if (sim.ranks->distributed()) check_ghost_layer(sim);
     // A larger reach may make the current slab colouring unsafe for this step's scatter.
     if (reach_ > old_reach && sim.failure.empty())
       for (auto& set : sim.sets)
@@ -293,6 +297,21 @@ class Cpdi : public ShapeFunction<D> {
   bool merged_ = false;  // this step: every domain under a cell along every axis (3^D nodes)
   int F_ = -1, half_ = -1, R_ = -1;
   int reach_ = 1;
+  double max_cells_ = 0;  // the step's largest domain half-extent in cells, along any axis
+
+  /// Under mpirun: a corner within e_d of its particle lies at most floor(e_d / h_d) + 1 cell
+  /// rows from the particle's, and its tents reach one row further up; the ghost layer the
+  /// ranks exchange (one row below, two above: the reach when the grid was split) holds that
+  /// while every domain's half-extent is below a cell. The largest over the ranks decides, so
+  /// that every rank stops at the same step with the same words.
+  void check_ghost_layer(Simulation<D>& sim) const {
+    const double cells = sim.ranks->max(max_cells_);
+    if (int(std::floor(cells)) + 1 <= 1 || !sim.failure.empty()) return;
+    sim.failure = "a CPDI particle domain reaches " + format_number(cells) +
+                  " cells from its particle: under mpirun the ranks exchange a ghost layer of "
+                  "one cell (the domains must stay within a cell of their particle; "
+                  "docs/parallel.md); a smaller cpdi max_stretch, or a serial run";
+  }
   static constexpr size_t kParallelMin =
       4096;  // fewer particles: not worth a fork/join  // rows a corner's cell can lie from the
              // particle's cell along the last axis
@@ -361,6 +380,7 @@ class Cpdi : public ShapeFunction<D> {
     double max_cells = 0;   // largest half-extent in cells along any axis
     for (auto& set : sim.sets)
       if (failure.empty()) update_domains(sim, set.particles, failure, max_extent, max_cells);
+    max_cells_ = max_cells;
     // Merge below a spread of 2 e < h, with a margin so that rounding in the corner coordinates
     // cannot put two corners two cells apart.
     merged_ = 2.0 * max_cells < 1.0 - 1e-9;

@@ -88,6 +88,13 @@ void MpiRanks<D>::sum(double* values, int n) const {
 }
 
 template <int D>
+void MpiRanks<D>::max(double* values, int n) const {
+  if (n > 0)
+    mpi_check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_DOUBLE, MPI_MAX, cart_.comm()),
+              "MPI_Allreduce");
+}
+
+template <int D>
 std::string MpiRanks<D>::first_message(const std::string& mine) const {
   const int first = all_reduce(mine.empty() ? cart_.size() : cart_.rank(), MPI_INT, MPI_MIN);
   if (first == cart_.size()) return "";

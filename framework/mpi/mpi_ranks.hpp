@@ -38,6 +38,7 @@ class MpiRanks : public Ranks<D> {
   double max(double v) const override;
   int max(int v) const override;
   void sum(double* values, int n) const override;
+  void max(double* values, int n) const override;
   std::string first_message(const std::string& mine) const override;
   std::vector<long> gather(long n) const override;
   std::vector<double> gather(const std::vector<double>& mine) const override;

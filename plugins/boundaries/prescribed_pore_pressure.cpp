@@ -58,6 +58,9 @@ class PrescribedPorePressure : public HydraulicFace<D> {
     for (size_t k = 0; k < this->nodes_.size(); ++k)
       z_[k] = sim.grid.node_coord(this->nodes_[k], D - 1);
   }
+  /// Per node of the face, on the stored box (docs/parallel.md): the face forces are added
+  /// after the nodal sums are complete, to every stored copy of a node alike.
+  bool runs_on_ranks() const override { return true; }
   void add_forces(const GridForces& f) const override {
     if (f.count < 2 || !f.porosity.base) return;
     const int a = this->face_.axis;

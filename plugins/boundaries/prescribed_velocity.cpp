@@ -50,6 +50,8 @@ class PrescribedVelocity : public Boundary<D> {
     for (int d = 0; d < D; ++d) v_[size_t(d)] = p.vec("velocity")[size_t(d)];
   }
   bool applies_to(int phase) const override { return (phases_ >> phase) & 1; }
+  /// Per node of the stored box (docs/parallel.md), on a face or a box of nodes.
+  bool runs_on_ranks() const override { return true; }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     check_phase_mask(phases_, sim.scheme->phases(), params_, diag);

@@ -37,9 +37,9 @@ class Slip : public Boundary<D> {
         box_(!p.has("face")),
         phases_(parse_phase_mask(p)) {}
   bool applies_to(int phase) const override { return (phases_ >> phase) & 1; }
-  /// On a face, per node of the stored box; a box of nodes inside the grid not yet (a rank's
-  /// box may hold none of its nodes).
-  bool runs_on_ranks() const override { return !box_; }
+  /// Per node of the stored box, on a face or a box of nodes (a rank holds its stored nodes of
+  /// the box, maybe none).
+  bool runs_on_ranks() const override { return true; }
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     check_phase_mask(phases_, sim.scheme->phases(), params_, diag);
     face_or_box_components(sim.grid, params_, face_, box_, nodes_, fixed_, diag);

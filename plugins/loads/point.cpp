@@ -43,10 +43,13 @@ class PointLoad : public Load<D> {
         ijk[size_t(d)] = c + (up ? 1 : 0);
         w *= up ? r : 1 - r;
       }
+      if (!g.stores(ijk)) continue;  // under mpirun: another rank's box (docs/parallel.md)
       nodes_.push_back(g.node_index(ijk));
       weights_.push_back(w);
     }
   }
+  /// Added to every stored copy of its nodes, after the nodal sums are complete, as gravity.
+  bool runs_on_ranks() const override { return true; }
   void apply_to_grid(Simulation<D>&, const NodalVector& force, double t) override {
     const double s = time_(t);
     for (size_t k = 0; k < nodes_.size(); ++k)

@@ -24,29 +24,33 @@ struct Column {
     V0 = sum(sim, [&](size_t i) {
       return sim.particles_of_body(body).col(sim.particles_of_body(body).volume)[i];
     });
-    pore = sim.particles_of_body(body).find("pore_pressure");
+    // The body's own set must hold the field (the double-point scheme's solid set has none).
+    const auto& P = sim.particles_of_body(body);
+    pore = P.find("pore_pressure");
+    if (pore >= 0 && !P.has(pore)) pore = -1;
     return true;
   }
-  /// Sum of value(i) over the column's particles.
+  /// Sum of value(i) over the column's particles (over the ranks: every rank calls it).
   template <class F>
   double sum(const Simulation<D>& sim, F&& value) const {
     const auto& P = sim.particles_of_body(body);
     double total = 0;
     for (size_t i = 0; i < P.size(); ++i)
       if (P.body[i] == body) total += value(i);
+    sim.ranks->sum(&total, 1);
     return total;
   }
   double height(const Simulation<D>& sim) const {
     const double* V = sim.particles_of_body(body).col(sim.particles_of_body(body).volume);
     return sum(sim, [&](size_t i) { return V[i]; }) / (V0 / H0);
   }
-  /// max |p| over the column (Pa); only meaningful when pore >= 0.
+  /// max |p| over the column (Pa), over the ranks; only meaningful when pore >= 0.
   double max_pore_pressure(const Simulation<D>& sim) const {
     const auto& P = sim.particles_of_body(body);
     double worst = 0;
     for (size_t i = 0; i < P.size(); ++i)
       if (P.body[i] == body) worst = std::max(worst, std::fabs(P.col(pore)[i]));
-    return worst;
+    return sim.ranks->max(worst);
   }
 };
 

@@ -67,6 +67,15 @@ class ElasticColumn : public Reference<D> {
       ur2 += V * uz * uz;
       if (z > top_z) top_z = z, top_u = u;
     }
+    // Over the ranks: the sums, and the top particle of the rank holding the highest one (of
+    // equally high ones the first rank's, as serially the first particle's).
+    double sums[8] = {mean_sv, vol, e2, r2, h2, hr2, u2, ur2};
+    sim.ranks->sum(sums, 8);
+    mean_sv = sums[0], vol = sums[1], e2 = sums[2], r2 = sums[3];
+    h2 = sums[4], hr2 = sums[5], u2 = sums[6], ur2 = sums[7];
+    const std::vector<double> tops = sim.ranks->all_gather({top_z, top_u});
+    for (size_t k = 0; k + 1 < tops.size(); k += 2)
+      if (k == 0 || tops[k] > top_z) top_z = tops[k], top_u = tops[k + 1];
     std::map<std::string, double> m;
     m["stress_error_l2"] = std::sqrt(e2 / r2);
     m["horizontal_stress_error_l2"] = hr2 > 0 ? std::sqrt(h2 / hr2) : std::sqrt(h2 / r2);
@@ -77,6 +86,8 @@ class ElasticColumn : public Reference<D> {
     return m;
   }
 
+  /// The column's integrals are sums over the ranks, its top particle the highest over them.
+  bool runs_on_ranks() const override { return true; }
   /// Checkpoints: nothing accumulates; everything is the set-up's or the final state's.
   bool save_state(std::vector<double>&) const override { return true; }
 

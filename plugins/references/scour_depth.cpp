@@ -86,6 +86,8 @@ class ScourDepth : public Reference<D> {
   std::vector<std::pair<std::string, std::vector<double>>> series() const override {
     return {{"time", time_}, {"scour_depth", depth_}};
   }
+  /// The strip's highest grain is a maximum over the ranks.
+  bool runs_on_ranks() const override { return true; }
 
   bool save_state(std::vector<double>& s) const override {
     s = {clock_.next};
@@ -112,7 +114,7 @@ class ScourDepth : public Reference<D> {
         in = in && std::fabs(P.col(P.position, d)[i] - axis_[size_t(d)]) <= half_width_;
       if (in) top = std::max(top, P.col(P.position, D - 1)[i]);
     }
-    return top;
+    return sim.ranks->max(top);  // over the ranks (identity serially)
   }
 
   Params params_;

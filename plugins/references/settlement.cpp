@@ -72,6 +72,8 @@ class Settlement : public Reference<D> {
     return m;
   }
 
+  /// The column's sums and largest pore pressure are over the ranks (column.hpp).
+  bool runs_on_ranks() const override { return true; }
   /// Checkpoints: nothing accumulates; everything is the set-up's or the final state's.
   bool save_state(std::vector<double>&) const override { return true; }
 

@@ -173,6 +173,9 @@ class SheetPileSeepage : public Reference<D> {
       if (x[i] < x_pile_ - d_ / 2) up += h, ++n_up;
       if (x[i] > x_pile_ + d_ / 2) down += h, ++n_down;
     }
+    double sides[4] = {up, double(n_up), down, double(n_down)};
+    sim.ranks->sum(sides, 4);  // over the ranks (identity serially)
+    up = sides[0], n_up = size_t(sides[1]), down = sides[2], n_down = size_t(sides[3]);
     const double h_up = n_up ? up / double(n_up) : std::nan("");
     const double h_down = n_down ? down / double(n_down) : std::nan("");
     const double dH = h_up - h_down;
@@ -186,6 +189,7 @@ class SheetPileSeepage : public Reference<D> {
       auto& a = cells[c];
       a[0] += x[i], a[1] += y[i], a[2] += p[i], a[3] += 1;
     }
+    merge_over_ranks(*sim.ranks, cells);
     double sy = 0, sh = 0, shh = 0, syy = 0, syh = 0, syhh = 0, n = 0;
     for (const auto& [c, a] : cells) {
       const double w = a[3], xc = a[0] / w, yc = a[1] / w;
@@ -213,6 +217,14 @@ class SheetPileSeepage : public Reference<D> {
         const long r = std::min(long(pipe_rows.size()) - 1, long((y - (surface_ - d_)) / row));
         pipe_rows[size_t(r)] = 1;
       }
+    if (sim.ranks->distributed()) {  // over the ranks: the count summed, the rows or-ed
+      double count = double(fluidised);
+      sim.ranks->sum(&count, 1);
+      fluidised = long(count);
+      std::vector<double> rows(pipe_rows.begin(), pipe_rows.end());
+      sim.ranks->max(rows.data(), int(rows.size()));
+      for (size_t r = 0; r < rows.size(); ++r) pipe_rows[r] = rows[r] > 0 ? 1 : 0;
+    }
     const double pipe =
         double(std::count(pipe_rows.begin(), pipe_rows.end(), 1)) / double(pipe_rows.size());
     time_.push_back(sim.time);
@@ -272,6 +284,9 @@ class SheetPileSeepage : public Reference<D> {
             {"heave", heave_}};
   }
 
+  /// Its sums, counts and per-cell sums are over the ranks (cell sums merged by cell).
+  bool runs_on_ranks() const override { return true; }
+
   bool save_state(std::vector<double>& s) const override {
     s = {clock_.next, critical_, fluidised_head_, double(time_.size())};
     for (const auto* v : {&time_, &head_, &up_, &down_, &exit_, &harr_, &exit_p_, &harr_p_,
@@ -327,6 +342,7 @@ class SheetPileSeepage : public Reference<D> {
           a[5] += S.has(porosity_) ? S.col(porosity_)[i] : n0_;
           a[6] += 1;
         });
+    merge_over_ranks(*sim.ranks, cells);
     double sum = 0, sum_harr = 0, weight = 0;
     const double dy = 1e-4 * d_;
     for (const auto& [c, a] : cells) {
@@ -361,7 +377,28 @@ class SheetPileSeepage : public Reference<D> {
       if (P.body[i] != body_ || x < x_pile_ || x > x_pile_ + d_ / 2) continue;
       top = std::max(top, P.col(P.position, D - 1)[i]);
     }
-    return top;
+    return sim.ranks->max(top);  // over the ranks
+  }
+
+  /// Per-cell sums of the ranks added cell by cell (in rank order) into every rank's map: each
+  /// entry goes as its D cell indices and N sums. Serially nothing is done.
+  template <size_t N>
+  static void merge_over_ranks(const Ranks<D>& ranks,
+                               std::map<std::array<long, D>, std::array<double, N>>& cells) {
+    if (!ranks.distributed()) return;
+    std::vector<double> mine;
+    for (const auto& [c, a] : cells) {
+      for (long k : c) mine.push_back(double(k));
+      mine.insert(mine.end(), a.begin(), a.end());
+    }
+    const std::vector<double> all = ranks.all_gather(mine);
+    cells.clear();
+    for (size_t k = 0; k + D + N <= all.size(); k += D + N) {
+      std::array<long, D> c{};
+      for (int d = 0; d < D; ++d) c[size_t(d)] = long(all[k + size_t(d)]);
+      auto& a = cells[c];
+      for (size_t j = 0; j < N; ++j) a[j] += all[k + D + j];
+    }
   }
 
   Params params_;

@@ -90,6 +90,21 @@ class SlopeFailure : public Reference<D> {
     bottom_ = b.lower[D - 1];
     for (int d = 0; d < D; ++d) half_[size_t(d)] = 0.5 * b.spacing[size_t(d)];
     x_ref_ = sim.request_displacement_reference();
+    // Per particle (fields, so that they travel with a particle to another rank and into
+    // checkpoints): its position at the last sample, and the last sample it moved fast.
+    const int set = sim.body_set(body_);
+    prev_ = sim.request_field(
+        {"slope_failure_previous_position", D, "m",
+         "slope_failure: the position at its last sample", Particles<D>::axis_names()},
+        set);
+    last_fast_ = sim.request_field(
+        {"slope_failure_last_fast",
+         1,
+         "s",
+         "slope_failure: the last sample (since the reset) the particle moved faster than "
+         "rest_speed",
+         {}},
+        set);
     restart(sim, 0);
   }
 
@@ -101,27 +116,32 @@ class SlopeFailure : public Reference<D> {
         restart(sim, sim.time - sim.dt);
     }
     if (!clock_.due(sim.time - t0_)) return;
-    const Particles<D>& P = sim.particles_of_body(body_);
+    Particles<D>& P = sim.particles_of_body(body_);
     double umax = 0, usum = 0, vmax = 0;
     long n = 0;
     const double interval = sim.time - t_prev_;
     for (size_t i = 0; i < P.size(); ++i) {
       if (!measured(P, i)) continue;
-      const size_t k = P.id[i] - first_id_;
-      double* prev = &prev_[size_t(D) * k];
       double u2 = 0, s2 = 0;
       for (int d = 0; d < D; ++d) {
         const double x = P.col(P.position, d)[i];
+        double& prev = P.col(prev_, d)[i];
         u2 += std::pow(x - P.col(x_ref_, d)[i], 2);
-        s2 += std::pow(x - prev[d], 2);
-        prev[d] = x;
+        s2 += std::pow(x - prev, 2);
+        prev = x;
       }
       umax = std::max(umax, std::sqrt(u2));
       usum += std::sqrt(u2);
       vmax = std::max(vmax, std::sqrt(s2));
-      if (interval > 0 && std::sqrt(s2) > rest_speed_ * interval) last_fast_[k] = sim.time - t0_;
+      if (interval > 0 && std::sqrt(s2) > rest_speed_ * interval)
+        P.col(last_fast_)[i] = sim.time - t0_;
       ++n;
     }
+    // Over the ranks (identity serially).
+    double maxima[2] = {umax, vmax}, sums[2] = {usum, double(n)};
+    sim.ranks->max(maxima, 2);
+    sim.ranks->sum(sums, 2);
+    umax = maxima[0], vmax = maxima[1], usum = sums[0], n = long(sums[1]);
     t_prev_ = sim.time;
     time_.push_back(sim.time - t0_);
     max_u_.push_back(umax);
@@ -150,8 +170,15 @@ class SlopeFailure : public Reference<D> {
       front = std::max(front, P.col(P.position, 0)[i] + half_[0]);
       top_moved = std::max(top_moved, y + half_[D - 1]);
       volume += P.col(P.volume)[i];
-      moving_until = std::max(moving_until, last_fast_[P.id[i] - first_id_]);
+      moving_until = std::max(moving_until, P.col(last_fast_)[i]);
     }
+    // Over the ranks: the failed mass's extremes (the lowest base as the largest -base) and
+    // volume.
+    double maxima[6] = {depth, front, top_moved, surface, moving_until, -base};
+    sim.ranks->max(maxima, 6);
+    depth = maxima[0], front = maxima[1], top_moved = maxima[2], surface = maxima[3];
+    moving_until = maxima[4], base = -maxima[5];
+    sim.ranks->sum(&volume, 1);
     const bool failed = volume > 0;
     std::map<std::string, double> m;
     m["failed_volume"] = volume;  // m^3, per metre of thickness in 2D (m^2)
@@ -184,9 +211,14 @@ class SlopeFailure : public Reference<D> {
             {"interval_speed", speed_}};
   }
 
+  /// The sums and extremes of the samples and metrics are over the ranks; each particle's
+  /// previous position and last fast sample are particle fields (they move with it).
+  bool runs_on_ranks() const override { return true; }
+
+  /// The series and the clock; the per-particle state is in the particles' fields.
   bool save_state(std::vector<double>& s) const override {
     s = {clock_.next, t0_, t_prev_, double(stage_), double(time_.size())};
-    for (const auto* v : {&time_, &max_u_, &mean_u_, &speed_, &last_fast_, &prev_})
+    for (const auto* v : {&time_, &max_u_, &mean_u_, &speed_})
       s.insert(s.end(), v->begin(), v->end());
     return true;
   }
@@ -201,21 +233,17 @@ class SlopeFailure : public Reference<D> {
       v->assign(it, it + n);
       it += n;
     }
-    const auto count = std::ptrdiff_t(s.end() - it) / (D + 1);
-    last_fast_.assign(it, it + count);
-    prev_.assign(it + count, s.end());
   }
 
  private:
   /// Begin the measurement at time t0 from the displacement reference (the reset positions).
-  void restart(const Simulation<D>& sim, double t0) {
-    const Particles<D>& P = sim.particles_of_body(body_);
-    prev_.assign(size_t(D) * count_, 0.0);
-    last_fast_.assign(count_, 0.0);
-    for (size_t i = 0; i < P.size(); ++i)
-      if (measured(P, i))
-        for (int d = 0; d < D; ++d)
-          prev_[size_t(D) * (P.id[i] - first_id_) + size_t(d)] = P.col(x_ref_, d)[i];
+  void restart(Simulation<D>& sim, double t0) {
+    Particles<D>& P = sim.particles_of_body(body_);
+    for (size_t i = 0; i < P.size(); ++i) {
+      if (!measured(P, i)) continue;
+      P.col(last_fast_)[i] = 0;
+      for (int d = 0; d < D; ++d) P.col(prev_, d)[i] = P.col(x_ref_, d)[i];
+    }
     t0_ = t_prev_ = t0;
     clock_.restart();
     time_.clear(), max_u_.clear(), mean_u_.clear(), speed_.clear();
@@ -268,6 +296,7 @@ class SlopeFailure : public Reference<D> {
         double& t = top[column_of(P, i)];
         t = std::max(t, P.col(x_ref_, D - 1)[i] + half_[D - 1]);
       }
+    sim.ranks->max(top.data(), int(top.size()));  // over the ranks
     return top;
   }
 
@@ -277,14 +306,13 @@ class SlopeFailure : public Reference<D> {
   double rest_speed_;
   SampleClock clock_;
   int body_ = -1, x_ref_ = -1, stage_ = -1;
+  int prev_ = -1, last_fast_ = -1;  // fields: the position at the last sample, the last fast one
   size_t first_id_ = 0, count_ = 0;
   double bottom_ = 0, t0_ = 0, t_prev_ = 0;
   std::array<double, D> half_{};
   std::array<double, D> origin_{};
   std::array<long, D> ncol_{};
   std::vector<double> time_, max_u_, mean_u_, speed_;
-  std::vector<double> prev_;       // per particle (id order): its position at the last sample
-  std::vector<double> last_fast_;  // per particle: the last sample it moved faster than rest
 };
 
 LOAM_REGISTER(Reference, SlopeFailure)

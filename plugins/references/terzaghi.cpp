@@ -102,6 +102,10 @@ class Terzaghi : public Reference<D> {
       pv += V[i] * p[i];
       vol += V[i];
     }
+    err = sim.ranks->max(err);  // over the ranks (identity serially)
+    double sums[2] = {pv, vol};
+    sim.ranks->sum(sums, 2);
+    pv = sums[0], vol = sums[1];
     const double u_err = std::fabs(1 - pv / (vol * p0_) - terzaghi_degree(T));
     for (size_t k = 0; k < factors_.size(); ++k)
       if (std::isnan(max_err_[k]) && T >= factors_[k] * (1 - 1e-12)) {
@@ -126,6 +130,10 @@ class Terzaghi : public Reference<D> {
     return m;
   }
 
+  /// The column's span and the largest error are maxima over the ranks, the mean pressure's
+  /// integrals sums.
+  bool runs_on_ranks() const override { return true; }
+
   bool save_state(std::vector<double>& s) const override {
     s = max_err_;  // the geometry (H0, span0, offsets) is the set-up's, recomputed on resume
     s.insert(s.end(), u_err_.begin(), u_err_.end());
@@ -144,7 +152,7 @@ class Terzaghi : public Reference<D> {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (size_t i = 0; i < P.size(); ++i)
       if (P.body[i] == body_) lo = std::min(lo, z[i]), hi = std::max(hi, z[i]);
-    return {lo, hi};
+    return {-sim.ranks->max(-lo), sim.ranks->max(hi)};  // over the ranks
   }
 
   Params params_;

@@ -37,17 +37,23 @@ class VibratingBar : public Reference<D> {
     length_ = b.upper[0] - b.lower[0];
     x0_ = b.lower[0];
     omega_ = M_PI / (2 * length_) * std::sqrt(mat.real("E") / mat.real("density"));
-    auto& P = sim.particles_of_body(body_);
-    // Mode shape at the initial positions, kept by particle id.
-    phi_.assign(sim.num_particles(), 0.0);  // by id: ids count over all sets
+    // Mode shape at the initial positions, kept by particle id (ids count over all sets). Under
+    // mpirun every rank keeps the whole bar's: a particle may move to another rank.
+    const auto& P = sim.particles_of_body(body_);
+    std::vector<double> own;  // id, x, mass of this rank's particles of the bar
+    for (size_t i = 0; i < P.size(); ++i)
+      if (P.body[i] == body_)
+        own.insert(own.end(), {double(P.id[i]), P.col(P.position, 0)[i], P.col(P.mass)[i]});
+    const std::vector<double> all = sim.ranks->all_gather(own);
+    phi_.assign(sim.next_particle_id(), 0.0);
+    x_init_.assign(phi_.size(), 0.0);
     norm_ = 0;
-    for (size_t i = 0; i < P.size(); ++i) {
-      if (P.body[i] != body_) continue;
-      const double x = P.col(P.position, 0)[i];
-      phi_[P.id[i]] = std::sin(M_PI * (x - x0_) / (2 * length_));
-      x_init_.resize(sim.num_particles());
-      x_init_[P.id[i]] = x;
-      norm_ += P.col(P.mass)[i] * phi_[P.id[i]] * phi_[P.id[i]];
+    for (size_t k = 0; k + 2 < all.size(); k += 3) {
+      const size_t id = size_t(all[k]);
+      const double x = all[k + 1];
+      phi_[id] = std::sin(M_PI * (x - x0_) / (2 * length_));
+      x_init_[id] = x;
+      norm_ += all[k + 2] * phi_[id] * phi_[id];
     }
     e0_ = energy(sim);
   }
@@ -68,6 +74,9 @@ class VibratingBar : public Reference<D> {
       err2 += m[i] * std::pow(u - u_amp * ph * s, 2);  // u_exact = (v0/w) phi sin(w t)
       mass += m[i];
     }
+    double sums[4] = {qd, q, err2, mass};
+    sim.ranks->sum(sums, 4);  // over the ranks (identity serially)
+    qd = sums[0], q = sums[1], err2 = sums[2], mass = sums[3];
     // Mass-weighted RMS displacement error relative to the tip amplitude, worst over time.
     field_error_ = std::max(field_error_, std::sqrt(err2 / mass) / u_amp);
     qd /= norm_;
@@ -98,6 +107,9 @@ class VibratingBar : public Reference<D> {
     }  // fewer than two crossings: no period metrics (a test reading them then fails loudly)
     return m;
   }
+
+  /// Every rank keeps the whole bar's mode shape; the modal sums are over the ranks.
+  bool runs_on_ranks() const override { return true; }
 
   bool save_state(std::vector<double>& s) const override {
     s = {last_v_, last_t_, max_u_, drift_, field_error_};

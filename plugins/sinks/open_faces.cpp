@@ -21,6 +21,7 @@ class OpenFaces : public SinkOnSets<D> {
   }
   explicit OpenFaces(const Params& p) : SinkOnSets<D>(p) {}
 
+  bool runs_on_ranks() const override { return true; }  // per particle
   void mark(const Simulation<D>& sim, const ParticleSet<D>& set,
             std::vector<uint8_t>& remove) const override {
     if (!this->acts_on(sim, set)) return;

@@ -35,6 +35,7 @@ class Plane : public SinkOnSets<D> {
     }
     for (auto& n : n_) n /= std::sqrt(n2);
   }
+  bool runs_on_ranks() const override { return true; }  // per particle
   void mark(const Simulation<D>& sim, const ParticleSet<D>& set,
             std::vector<uint8_t>& remove) const override {
     if (!this->acts_on(sim, set)) return;

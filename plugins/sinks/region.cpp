@@ -22,6 +22,7 @@ class Region : public SinkOnSets<D> {
     for (int d = 0; d < D; ++d)
       lo_[size_t(d)] = p.vec("min")[size_t(d)], hi_[size_t(d)] = p.vec("max")[size_t(d)];
   }
+  bool runs_on_ranks() const override { return true; }  // per particle
   void mark(const Simulation<D>& sim, const ParticleSet<D>& set,
             std::vector<uint8_t>& remove) const override {
     if (!this->acts_on(sim, set)) return;

@@ -96,6 +96,9 @@ class Inflow : public Source<D> {
   }
 
   void region(Vec& lower, Vec& upper) const override { lower = lo_, upper = hi_; }
+  /// What it creates follows from its state and the time alone, the same on every rank; the
+  /// inlet velocity is prescribed per particle.
+  bool runs_on_ranks() const override { return true; }
   bool save_state(std::vector<double>& s) const override {
     s = {filled_ ? 1.0 : 0.0, newest_time_, newest_offset_};
     return true;

@@ -111,6 +111,9 @@ class Reservoir : public Source<D> {
   }
 
   void region(Vec& lower, Vec& upper) const override { lower = lo_, upper = hi_; }
+  /// The particles in the box are followed over all ranks (the nearest one to the refill face
+  /// a MAX, their count and velocity sums a sum), so every rank creates the same layers.
+  bool runs_on_ranks() const override { return true; }
   bool save_state(std::vector<double>&) const override { return true; }  // none: the level is t's
 
   void apply(Simulation<D>& sim, double) override {
@@ -132,6 +135,15 @@ class Reservoir : public Source<D> {
       nearest = std::max(nearest, sign() * P.col(P.position, a)[i]);
       for (int d = 0; d < D; ++d) v[size_t(d)] += P.col(P.velocity, d)[i];
       ++count;
+    }
+    if (sim.ranks->distributed()) {
+      nearest = sim.ranks->max(nearest);
+      double sums[D + 1];
+      for (int d = 0; d < D; ++d) sums[d] = v[size_t(d)];
+      sums[D] = double(count);
+      sim.ranks->sum(sums, D + 1);
+      for (int d = 0; d < D; ++d) v[size_t(d)] = sums[d];
+      count = size_t(sums[D]);
     }
     const double site = sign() * face_site(sim.time), sa = s_[size_t(a)];
     if (count == 0) {  // empty: fill it up to the level
