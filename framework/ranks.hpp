@@ -36,6 +36,9 @@ class Ranks {
   /// features that do not run on ranks yet are refused (Simulation's build).
   virtual bool distributed() const { return false; }
   virtual int rank() const { return 0; }
+  /// Whether the grid has been split (decompose succeeded): each rank then holds only its own
+  /// cells' particles. Before, or when the model has errors, every rank holds all of them.
+  virtual bool split() const { return false; }
   virtual int size() const { return 1; }
   bool root() const { return rank() == 0; }
   /// What ends the name of this rank's own file of an output split over the ranks (its piece

@@ -230,8 +230,6 @@ void Simulation<D>::split_over_ranks(Diagnostics& diag) {
     if (st.sets_damping && st.damping && sp[k].given("damping"))
       refuse_plugin(st.damping->runs_on_ranks(), sp[k].section("damping"));
   }
-  if (!config.list("selections").empty())
-    diag.error(config.where("selections"), "selections", "this key" + only);
   if (reference && config.given("verify"))
     refuse_plugin(reference->runs_on_ranks(), config.section("verify"));
   if (!shape || !diag.ok()) return;

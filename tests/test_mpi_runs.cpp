@@ -433,6 +433,25 @@ std::string elastic_column_2d() {
          "verify: {type: elastic_column}\n";
 }
 
+/// elastic_column_2d() with gimp on an absorbing base with its free-field reaction (a dashpot
+/// per node, each rank's own reaction state), loaded on its top by a traction applied at the
+/// particles' surface points (each rank's share completed over the ranks).
+std::string elastic_column_loaded_2d() {
+  std::string cfg = elastic_column_2d();
+  auto replace = [&](const std::string& a, const std::string& b) {
+    REQUIRE(cfg.find(a) != std::string::npos);
+    cfg.replace(cfg.find(a), a.size(), b);
+  };
+  replace("  - {type: fixed, face: y-}\n",
+          "  - {type: absorbing, face: y-, density: 2000, p_wave_speed: 820.4, s_wave_speed: "
+          "438.5, free_field: true}\n");
+  replace("gravity: [0, -9.81]\n", "gravity: [0, -9.81]\nshape_function: gimp\n");
+  replace("time:",
+          "loads:\n  - {type: traction, body: column, face: y+, traction: [0, -1.0e5], "
+          "apply_at: surface}\ntime:");
+  return cfg;
+}
+
 /// configs/seed003_water_jet_2d.yaml on 0.5 m cells for 0.5 s: the inflow (a jet across the cut
 /// at x = 10 m), the open faces' sink, ergun drag, fluidisation, verify: scour_depth (the
 /// strip's highest grain over the ranks).
@@ -558,6 +577,7 @@ TEST_CASE("mpirun -np 1, 2 and 4: whole runs match the serial run, every shape f
   // one slope_failure.
   scenes.push_back({"1D vibrating bar", vibrating_bar(), 0});
   scenes.push_back({"2D elastic column", elastic_column_2d(), 0});
+  scenes.push_back({"2D column absorbing, surface load", elastic_column_loaded_2d(), 0});
   // The jet falls along the cut between 2 blocks (x = 10 m) and splashes away from it: its
   // points cross the cut at 4 ranks (y = 5 m).
   scenes.push_back({"2D water jet double point", water_jet_2d(), 4, {"solid", "liquid"}});
@@ -931,17 +951,31 @@ TEST_CASE("mpirun: what does not run on ranks yet is refused with located errors
          "  - {name: top, min: [0.2, 0.5], max: [0.6, 0.6]}\n"
          "boundaries:\n"
          "  - {type: periodic, axis: y}\n"
-         "  - {type: absorbing, face: x+, density: 1000, p_wave_speed: 1.2, s_wave_speed: 0}\n"
+         "output: {every_time: 0.05, writer: {type: xdmf, grid: true}}\n"
          "time: {end: 0.1}\n"
          "probes:\n"
          "  - {name: corner, particle_near: [0.2, 0.2], fields: [velocity]}\n"
          "verify: {type: blast_wave, body: block, cavity: {type: sphere, center: [0.4, 0.4], "
          "radius: 0.05}, probes: [{name: a, position: [0.5, 0.4]}]}\n";
   check_refused(dir.path, 2,
-                {"run.yaml:9:3: error: selections: this key does not run under mpirun yet",
-                 "run.yaml:11:5: error: boundaries.0: 'periodic' does not run under mpirun yet",
-                 "run.yaml:12:5: error: boundaries.1: 'absorbing' does not run under mpirun yet",
+                {"run.yaml:11:5: error: boundaries.0: 'periodic' does not run under mpirun yet",
+                 "run.yaml:12:55: error: output.writer.grid: the grid output does not run under "
+                 "mpirun yet",
                  "run.yaml:16:9: error: verify: 'blast_wave' does not run under mpirun yet"});
+
+  // A traction on a selection two particle layers deep across the cut between 2 blocks
+  // (x = 0.5 m): the layers are on different ranks, and the check gathers them.
+  std::ofstream(dir.path / "run.yaml")
+      << "grid: {origin: [0, 0], extent: [1, 1], cell_size: 0.05}\n"
+         "bodies:\n  - name: block\n    generator: {type: box, min: [0.2, 0.2], max: [0.6, "
+         "0.6]}\n    material: {type: linear_elastic, E: 1000, nu: 0.3, density: 1000}\n"
+         "selections:\n  - {name: side, min: [0.475, 0.2], max: [0.525, 0.6]}\n"
+         "loads:\n  - {type: traction, selection: side, face: x+, traction: [1, 0]}\n"
+         "time: {end: 0.1}\n";
+  check_refused(dir.path, 2,
+                {"run.yaml:9:33: error: loads.0.selection: selection 'side' is more than one "
+                 "particle layer deep along the face normal (particles at x = 0.4875 and 0.5125 "
+                 "m on one line)"});
 
   // Four ranks on a grid of 3 cells along x: a gimp block needs 2 (its reach).
   std::ofstream(dir.path / "run.yaml")

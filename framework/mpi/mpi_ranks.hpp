@@ -30,6 +30,7 @@ class MpiRanks : public Ranks<D> {
 
   std::string decompose(Grid<D>& grid, int rows_below, int rows_above, int threads) override;
   typename Ranks<D>::CellBlock cell_block(const Grid<D>& grid) const override;
+  bool split() const override { return decomposition_ != nullptr; }
   void complete_nodes(const std::vector<NodalArray>& arrays) override;
   void complete_cells(double* sums, int K) override;
   bool migrate(Particles<D>& P, long& strays, long& first_stray) override;

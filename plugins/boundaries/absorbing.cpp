@@ -114,6 +114,10 @@ class Absorbing : public Boundary<D> {
   /// whose particles are not modelled, so the particles stay inside (a body pressed onto the
   /// face, which drifts at t / (rho c_p), piles up against it instead of leaving the grid).
   int holds_face(int) const override { return face_index(face_); }
+  /// Per node of the face, on the stored box: the dashpots act on complete nodal masses and
+  /// velocities, the free-field reaction is each stored copy's own (the same on every rank that
+  /// stores the node) and goes into each rank's checkpoint.
+  bool runs_on_ranks() const override { return true; }
 
   /// free_field: the reaction of the first step, R = -f at the face's nodes (every component,
   /// each phase), then added to every step's forces.

@@ -71,9 +71,10 @@ class Traction : public Load<D> {
   bool uses_particle_forces() const override { return !surface_; }
   /// Applied as particle forces (scattered before the nodal sums are completed), each rank
   /// holding every loaded particle's id and area, so a particle that changes rank keeps its
-  /// load. At the surface, not yet: the grid load of a particle would reach the nodes of its
-  /// rank only.
-  bool runs_on_ranks() const override { return !surface_; }
+  /// load. At the surface: each rank adds its own particles' surface forces to a nodal array
+  /// that is completed over the ranks (one more halo exchange per step) before it joins the
+  /// nodal forces.
+  bool runs_on_ranks() const override { return true; }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     if (!check_face(face_, D, params_, "face", diag)) return;
@@ -123,6 +124,19 @@ class Traction : public Load<D> {
 
   void apply_to_grid(Simulation<D>& sim, const NodalVector& force, double t) override {
     if (!surface_) return;
+    // One rank (serially, or mpirun -np 1) adds them directly: the serial run's bits.
+    if (sim.ranks->size() == 1) return add_surface_forces(sim, force, t);
+    const size_t n = sim.grid.num_nodes;
+    surface_force_.assign(n * D, 0.0);
+    add_surface_forces(sim, NodalVector{surface_force_.data(), D, 0}, t);
+    sim.complete_nodes({{surface_force_.data(), D, D}});  // every rank calls it, every step
+    for (size_t i = 0; i < n; ++i)
+      for (int d = 0; d < D; ++d) force.at(i, d) += surface_force_[i * D + size_t(d)];
+  }
+
+ private:
+  /// t A_p N_I(x_s) of this rank's loaded particles, added to `force`.
+  void add_surface_forces(Simulation<D>& sim, const NodalVector& force, double t) const {
     const double s = time_(t);
     const auto& set = sim.sets[size_t(set_)];
     const auto& P = set.particles;
@@ -157,6 +171,7 @@ class Traction : public Load<D> {
     }
   }
 
+ public:
   void apply_to_particles(Simulation<D>& sim, double t) override {
     if (surface_) return;
     const double s = time_(t);
@@ -188,23 +203,31 @@ class Traction : public Load<D> {
 
   /// Each selected particle carries t A_p: a selection two particles deep along the face normal
   /// would carry the traction twice. Particles on one line normal to the face share their
-  /// tangential lattice cell (floor(x / spacing) on every other axis, at set-up).
+  /// tangential lattice cell (floor(x / spacing) on every other axis, at set-up). On a split
+  /// grid the lines are gathered from every rank (a second layer may be on another rank).
   void check_one_layer(const Simulation<D>& sim, Diagnostics& diag) const {
     const auto& set = sim.sets[size_t(set_)];
     const auto& P = set.particles;
-    std::map<std::array<long, D>, size_t> line;  // tangential cell -> first particle on it
+    std::vector<double> mine;  // per selected particle: its tangential cell, then its coordinate
     for (uint32_t id : ids_) {
       const size_t i = set.index_of(id);
       const auto& spacing = sim.bodies[P.body[i]].spacing;
-      std::array<long, D> key{};
       for (int d = 0; d < D; ++d)
-        if (d != face_.axis)
-          key[size_t(d)] = long(std::floor(P.col(P.position, d)[i] / spacing[size_t(d)]));
-      const auto [it, first] = line.emplace(key, i);
+        mine.push_back(d == face_.axis ? 0.0
+                                       : std::floor(P.col(P.position, d)[i] / spacing[size_t(d)]));
+      mine.push_back(P.col(P.position, face_.axis)[i]);
+    }
+    // Unsplit (a refused run) every rank holds every particle: its own list is the whole one.
+    const std::vector<double> all = sim.ranks->split() ? sim.ranks->all_gather(mine) : mine;
+    std::map<std::array<long, D>, double> line;  // tangential cell -> the first one's coordinate
+    for (size_t k = 0; k + D < all.size(); k += D + 1) {
+      std::array<long, D> key{};
+      for (int d = 0; d < D; ++d) key[size_t(d)] = long(all[k + size_t(d)]);
+      const double b = all[k + D];
+      const auto [it, first] = line.emplace(key, b);
       if (first) continue;
       const char* axes = "xyz";
-      const double a = P.col(P.position, face_.axis)[it->second];
-      const double b = P.col(P.position, face_.axis)[i];
+      const double a = it->second;
       diag.error(params_.where("selection"), params_.path("selection"),
                  "selection '" + params_.text("selection") +
                      "' is more than one particle layer deep along the face normal (particles "
@@ -227,6 +250,7 @@ class Traction : public Load<D> {
   std::array<double, D> t_{};
   std::vector<uint32_t> ids_;
   std::vector<double> area_;
+  std::vector<double> surface_force_;  // under mpirun: this rank's surface forces, per node
 };
 
 LOAM_REGISTER(Load, Traction)
