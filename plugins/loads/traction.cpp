@@ -134,6 +134,18 @@ class Traction : public Load<D> {
       for (int d = 0; d < D; ++d) force.at(i, d) += surface_force_[i * D + size_t(d)];
   }
 
+  void apply_to_particles(Simulation<D>& sim, double t) override {
+    if (surface_) return;
+    const double s = time_(t);
+    auto& set = sim.sets[size_t(set_)];
+    auto& P = set.particles;
+    for (size_t k = 0; k < ids_.size(); ++k) {
+      const size_t i = set.index_of(ids_[k]);
+      if (i == set.npos) continue;  // not in the run (its body waits for a stage)
+      for (int d = 0; d < D; ++d) P.col(sim.external_force, d)[i] += s * t_[size_t(d)] * area_[k];
+    }
+  }
+
  private:
   /// t A_p N_I(x_s) of this rank's loaded particles, added to `force`.
   void add_surface_forces(Simulation<D>& sim, const NodalVector& force, double t) const {
@@ -171,20 +183,6 @@ class Traction : public Load<D> {
     }
   }
 
- public:
-  void apply_to_particles(Simulation<D>& sim, double t) override {
-    if (surface_) return;
-    const double s = time_(t);
-    auto& set = sim.sets[size_t(set_)];
-    auto& P = set.particles;
-    for (size_t k = 0; k < ids_.size(); ++k) {
-      const size_t i = set.index_of(ids_[k]);
-      if (i == set.npos) continue;  // not in the run (its body waits for a stage)
-      for (int d = 0; d < D; ++d) P.col(sim.external_force, d)[i] += s * t_[size_t(d)] * area_[k];
-    }
-  }
-
- private:
   /// Under mpirun: every rank's loaded particles (id, area, length) on every rank, in rank
   /// order (docs/parallel.md).
   void gather_over_ranks(const Ranks<D>& ranks) {
