@@ -113,6 +113,25 @@ class Ranks {
   virtual void barrier() const {}
 };
 
+/// Sums over all ranks of the given numbers, in place (one reduction for all of them; every
+/// rank calls it with the same list): sum_over_ranks(ranks, volume, count). Counts go through
+/// doubles, exact below 2^53.
+template <int D, class... T>
+void sum_over_ranks(const Ranks<D>& ranks, T&... values) {
+  double all[] = {double(values)...};
+  ranks.sum(all, int(sizeof...(T)));
+  size_t k = 0;
+  ((values = T(all[k++])), ...);
+}
+/// Maxima over all ranks of the given numbers, in place (as sum_over_ranks).
+template <int D, class... T>
+void max_over_ranks(const Ranks<D>& ranks, T&... values) {
+  double all[] = {double(values)...};
+  ranks.max(all, int(sizeof...(T)));
+  size_t k = 0;
+  ((values = T(all[k++])), ...);
+}
+
 /// Makes the ranks of a run of dimension D. Empty (the default): the serial Ranks. The MPI
 /// build's main sets these when the process was started by mpirun.
 struct RanksFactory {

@@ -16,10 +16,7 @@ template <int D>
 double Simulation<D>::wave_speed() const {
   double c = 0;
   for (const auto& s : sets)
-    for (size_t m = 0; m < materials.size(); ++m) {
-      const auto& r = s.partition.material_ranges[m];
-      if (r.end > r.begin) c = std::max(c, materials[m]->wave_speed(s.particles, r.begin, r.end));
-    }
+    for (size_t m = 0; m < materials.size(); ++m) c = std::max(c, rank_wave_speed(s, m));
   return c;
 }
 

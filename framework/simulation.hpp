@@ -297,10 +297,13 @@ class Simulation {
   /// that scales it per particle (the two-phase fast wave) must see the whole model's. Every
   /// rank calls it, in the same order.
   double material_wave_speed(const ParticleSet<D>& set, size_t m) const {
-    const auto& r = set.partition.material_ranges[m];
-    const double c =
-        r.end > r.begin ? materials[m]->wave_speed(set.particles, r.begin, r.end) : 0.0;
+    const double c = rank_wave_speed(set, m);
     return ranks->distributed() ? ranks->max(c) : c;
+  }
+  /// Material m's wave speed over this rank's particles of `set` (0 if it has none).
+  double rank_wave_speed(const ParticleSet<D>& set, size_t m) const {
+    const auto& r = set.partition.material_ranges[m];
+    return r.end > r.begin ? materials[m]->wave_speed(set.particles, r.begin, r.end) : 0.0;
   }
   long checked_step = -1;  // the last step whose particles passed the stability check
   /// With track_motion (a stage until: static), each checked step also measures how fast the

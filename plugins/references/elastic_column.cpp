@@ -69,10 +69,7 @@ class ElasticColumn : public Reference<D> {
     }
     // Over the ranks: the sums, and the top particle of the rank holding the highest one (of
     // equally high ones the first rank's, as serially the first particle's).
-    double sums[8] = {mean_sv, vol, e2, r2, h2, hr2, u2, ur2};
-    sim.ranks->sum(sums, 8);
-    mean_sv = sums[0], vol = sums[1], e2 = sums[2], r2 = sums[3];
-    h2 = sums[4], hr2 = sums[5], u2 = sums[6], ur2 = sums[7];
+    sum_over_ranks(*sim.ranks, mean_sv, vol, e2, r2, h2, hr2, u2, ur2);
     const std::vector<double> tops = sim.ranks->all_gather({top_z, top_u});
     for (size_t k = 0; k + 1 < tops.size(); k += 2)
       if (k == 0 || tops[k] > top_z) top_z = tops[k], top_u = tops[k + 1];

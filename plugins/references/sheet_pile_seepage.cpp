@@ -173,9 +173,7 @@ class SheetPileSeepage : public Reference<D> {
       if (x[i] < x_pile_ - d_ / 2) up += h, ++n_up;
       if (x[i] > x_pile_ + d_ / 2) down += h, ++n_down;
     }
-    double sides[4] = {up, double(n_up), down, double(n_down)};
-    sim.ranks->sum(sides, 4);  // over the ranks (identity serially)
-    up = sides[0], n_up = size_t(sides[1]), down = sides[2], n_down = size_t(sides[3]);
+    sum_over_ranks(*sim.ranks, up, n_up, down, n_down);  // identity serially
     const double h_up = n_up ? up / double(n_up) : std::nan("");
     const double h_down = n_down ? down / double(n_down) : std::nan("");
     const double dH = h_up - h_down;
@@ -218,9 +216,7 @@ class SheetPileSeepage : public Reference<D> {
         pipe_rows[size_t(r)] = 1;
       }
     if (sim.ranks->distributed()) {  // over the ranks: the count summed, the rows or-ed
-      double count = double(fluidised);
-      sim.ranks->sum(&count, 1);
-      fluidised = long(count);
+      sum_over_ranks(*sim.ranks, fluidised);
       std::vector<double> rows(pipe_rows.begin(), pipe_rows.end());
       sim.ranks->max(rows.data(), int(rows.size()));
       for (size_t r = 0; r < rows.size(); ++r) pipe_rows[r] = rows[r] > 0 ? 1 : 0;

@@ -138,10 +138,8 @@ class SlopeFailure : public Reference<D> {
       ++n;
     }
     // Over the ranks (identity serially).
-    double maxima[2] = {umax, vmax}, sums[2] = {usum, double(n)};
-    sim.ranks->max(maxima, 2);
-    sim.ranks->sum(sums, 2);
-    umax = maxima[0], vmax = maxima[1], usum = sums[0], n = long(sums[1]);
+    max_over_ranks(*sim.ranks, umax, vmax);
+    sum_over_ranks(*sim.ranks, usum, n);
     t_prev_ = sim.time;
     time_.push_back(sim.time - t0_);
     max_u_.push_back(umax);
@@ -174,11 +172,10 @@ class SlopeFailure : public Reference<D> {
     }
     // Over the ranks: the failed mass's extremes (the lowest base as the largest -base) and
     // volume.
-    double maxima[6] = {depth, front, top_moved, surface, moving_until, -base};
-    sim.ranks->max(maxima, 6);
-    depth = maxima[0], front = maxima[1], top_moved = maxima[2], surface = maxima[3];
-    moving_until = maxima[4], base = -maxima[5];
-    sim.ranks->sum(&volume, 1);
+    double lowest = -base;
+    max_over_ranks(*sim.ranks, depth, front, top_moved, surface, moving_until, lowest);
+    base = -lowest;
+    sum_over_ranks(*sim.ranks, volume);
     const bool failed = volume > 0;
     std::map<std::string, double> m;
     m["failed_volume"] = volume;  // m^3, per metre of thickness in 2D (m^2)

@@ -103,9 +103,7 @@ class Terzaghi : public Reference<D> {
       vol += V[i];
     }
     err = sim.ranks->max(err);  // over the ranks (identity serially)
-    double sums[2] = {pv, vol};
-    sim.ranks->sum(sums, 2);
-    pv = sums[0], vol = sums[1];
+    sum_over_ranks(*sim.ranks, pv, vol);
     const double u_err = std::fabs(1 - pv / (vol * p0_) - terzaghi_degree(T));
     for (size_t k = 0; k < factors_.size(); ++k)
       if (std::isnan(max_err_[k]) && T >= factors_[k] * (1 - 1e-12)) {

@@ -74,9 +74,7 @@ class VibratingBar : public Reference<D> {
       err2 += m[i] * std::pow(u - u_amp * ph * s, 2);  // u_exact = (v0/w) phi sin(w t)
       mass += m[i];
     }
-    double sums[4] = {qd, q, err2, mass};
-    sim.ranks->sum(sums, 4);  // over the ranks (identity serially)
-    qd = sums[0], q = sums[1], err2 = sums[2], mass = sums[3];
+    sum_over_ranks(*sim.ranks, qd, q, err2, mass);  // identity serially
     // Mass-weighted RMS displacement error relative to the tip amplitude, worst over time.
     field_error_ = std::max(field_error_, std::sqrt(err2 / mass) / u_amp);
     qd /= norm_;
