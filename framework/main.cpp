@@ -37,6 +37,9 @@ int main(int argc, char** argv) {
          "OpenMP threads (default: OMP_NUM_THREADS, else all cores within a container's CPU quota)")
       ->check(CLI::Range(1, 1024));
   run->add_flag("--quiet", run_opt.quiet, "no progress lines");
+  run->add_flag("--profile", run_opt.profile,
+                "time each phase of the step (summary.json: profile_seconds; under mpirun also "
+                "profile_seconds_by_rank)");
 
   std::string check_file;
   std::vector<std::string> check_sets;

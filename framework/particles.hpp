@@ -115,9 +115,12 @@ class Particles {
 
   /// Remove the particles with remove[i] != 0 from every column, keeping the others' order.
   void erase(const std::vector<uint8_t>& remove) {
+    // Everything before the first removed particle stays where it is.
+    size_t first = 0;
+    while (first < n_ && !remove[first]) ++first;
     auto compact = [&](auto& v) {
-      size_t k = 0;
-      for (size_t i = 0; i < n_; ++i)
+      size_t k = first;
+      for (size_t i = first; i < n_; ++i)
         if (!remove[i]) v[k++] = v[i];
       v.resize(k);
       return k;

@@ -7,6 +7,7 @@
 // neighbouring blocks after every scatter, hands particles over after the move, and reduces the
 // step's scalars (time step, energies, failures) over all ranks. The core and the schemes call
 // only this interface; the MPI code lives in libloam_mpi.
+#include <algorithm>
 #include <array>
 #include <functional>
 #include <memory>
@@ -48,8 +49,10 @@ class Ranks {
   /// Split the grid: this rank's box of nodes is stored in `grid` (Grid::store_nodes), which
   /// must outlive the ranks; `threads` pack and unpack the messages. Returns "" or why the grid
   /// cannot be split over these ranks (a block thinner than the shape function's reach).
+  /// No block boundary cuts an axis with whole[d] (a periodic axis: each rank holds both its
+  /// faces and joins them itself).
   virtual std::string decompose(Grid<D>& /*grid*/, int /*rows_below*/, int /*rows_above*/,
-                                int /*threads*/) {
+                                int /*threads*/, const std::array<bool, D>& /*whole*/) {
     return "";
   }
   /// This rank's block of grid cells, [lo, hi) per axis, where the block sits in the array of
@@ -130,6 +133,36 @@ void max_over_ranks(const Ranks<D>& ranks, T&... values) {
   ranks.max(all, int(sizeof...(T)));
   size_t k = 0;
   ((values = T(all[k++])), ...);
+}
+
+/// Per item, the candidate whose first `key` values are lexicographically smallest over all
+/// ranks: each rank gives n items of `width` values (the key, then values carried along; a rank
+/// without a candidate for an item puts +inf first). Every rank gets the n winners (collective;
+/// serially `mine`). Picks "the particle nearest to a point, of equally near ones the first in
+/// the serial order" (setup_order) whichever rank holds it.
+template <int D>
+std::vector<double> smallest_over_ranks(const Ranks<D>& ranks, const std::vector<double>& mine,
+                                        int width, int key) {
+  const std::vector<double> all = ranks.all_gather(mine);
+  std::vector<double> best(all.begin(), all.begin() + long(mine.size()));  // the first rank's
+  for (size_t r = 1; r * mine.size() < all.size(); ++r)
+    for (size_t k = 0; k < mine.size(); k += size_t(width)) {
+      const double* c = &all[r * mine.size() + k];
+      if (std::lexicographical_compare(c, c + key, &best[k], &best[k] + key))
+        std::copy(c, c + width, &best[k]);
+    }
+  return best;
+}
+
+/// Particle i's place in its set's order right after set-up, as a key of three doubles:
+/// (material, cell, id). Partition::sort is a stable sort by material and cell of particles
+/// generated in id order, so in a serial run this order is the index order, and under mpirun it
+/// is the same for a particle whichever rank holds it.
+template <int D>
+std::array<double, 3> setup_order(const Particles<D>& P, const Grid<D>& grid, size_t i) {
+  std::array<double, D> x{};
+  for (int d = 0; d < D; ++d) x[size_t(d)] = P.col(P.position, d)[i];
+  return {double(P.material[i]), double(grid.cell_index(x)), double(P.id[i])};
 }
 
 /// Makes the ranks of a run of dimension D. Empty (the default): the serial Ranks. The MPI

@@ -199,6 +199,9 @@ class Run {
     sim_->ranks->sum(&n, 1);
     return n;
   }
+  /// summary.json's profile_seconds_by_rank under mpirun: every rank's seconds per phase
+  /// (collective; the ranks time the same phases).
+  void profile_by_rank(nlohmann::json& summary) const;
   RunResult loop();
 };
 

@@ -164,12 +164,6 @@ void Run<D>::check_outputs(Diagnostics& diag) {
     if (n == "displacement") frame_fields_.push_back(displacement_);
     if (n == "strain_magnitude") frame_fields_.push_back(strain_magnitude_);
   }
-  if (sim_->ranks->distributed()) {  // what the output cannot do under mpirun yet
-    const std::string only = " does not run under mpirun yet (docs/parallel.md lists what does)";
-    const Params& w = out.section("writer");
-    if (w.has("grid") && w.flag("grid"))
-      diag.error(w.where("grid"), w.path("grid"), "the grid output" + only);
-  }
 }
 
 template <int D>

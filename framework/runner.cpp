@@ -549,6 +549,26 @@ nlohmann::json Run<D>::stage_record(const std::string& status) {
 }
 
 template <int D>
+void Run<D>::profile_by_rank(nlohmann::json& summary) const {
+  std::vector<double> mine;
+  for (const auto& [phase, seconds] : sim_->profile) mine.push_back(seconds);
+  const std::vector<double> all = sim_->ranks->gather(mine);
+  if (sim_->ranks->rank() != 0) return;
+  if (all.size() != size_t(sim_->ranks->size()) * mine.size()) {
+    summary["profile_seconds_by_rank"] = "the ranks timed different phases";
+    return;
+  }
+  nlohmann::json by_rank = nlohmann::json::array();
+  for (size_t r = 0; r * mine.size() < all.size(); ++r) {
+    nlohmann::json phases;
+    size_t k = 0;
+    for (const auto& [phase, seconds] : sim_->profile) phases[phase] = all[r * mine.size() + k++];
+    by_rank.push_back(phases);
+  }
+  summary["profile_seconds_by_rank"] = by_rank;
+}
+
+template <int D>
 RunResult Run<D>::loop() {
   RunResult res;
   InterruptGuard guard;  // SIGINT, SIGTERM: stop after the current step; SIGXFSZ ignored
@@ -803,6 +823,7 @@ RunResult Run<D>::loop() {
   res.summary["dt_max"] = ls_.dt_max;
   res.summary["frames"] = frames_;
   if (sim.profiling) res.summary["profile_seconds"] = sim.profile;
+  if (sim.profiling && distributed) profile_by_rank(res.summary);
   Energies e1 = sim.energies();
   // Sources and sinks: counts and the mass balance (round-off when nothing is lost).
   // Over the ranks: masses now and initial, particles and mass created and removed.

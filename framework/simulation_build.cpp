@@ -233,7 +233,17 @@ void Simulation<D>::split_over_ranks(Diagnostics& diag) {
   if (reference && config.given("verify"))
     refuse_plugin(reference->runs_on_ranks(), config.section("verify"));
   if (!shape || !diag.ok()) return;
-  const std::string why = ranks->decompose(grid, shape->rows_below(), shape->rows_above(), threads);
+  // A periodic axis stays whole on every rank (its faces are joined node by node).
+  std::array<bool, D> whole{};
+  auto keep_periodic_whole = [&](const auto& list) {
+    for (const auto& b : list)
+      if (b->periodic_axis() >= 0 && b->periodic_axis() < D)
+        whole[size_t(b->periodic_axis())] = true;
+  };
+  keep_periodic_whole(boundaries);
+  for (const Stage<D>& st : stages) keep_periodic_whole(st.boundaries);
+  const std::string why =
+      ranks->decompose(grid, shape->rows_below(), shape->rows_above(), threads, whole);
   if (!why.empty()) diag.error(config.section("grid").where(), "grid", why);
 }
 

@@ -10,7 +10,11 @@
 namespace loam {
 
 template <int D>
-std::string MpiRanks<D>::decompose(Grid<D>& grid, int rows_below, int rows_above, int threads) {
+std::string MpiRanks<D>::decompose(Grid<D>& grid, int rows_below, int rows_above, int threads,
+                                   const std::array<bool, D>& whole) {
+  if (!cart_.keep_whole(whole))
+    return "the grid is periodic along every axis: no axis is left to split over " +
+           std::to_string(cart_.size()) + " ranks (run it on one)";
   try {
     decomposition_ = std::make_unique<Decomposition<D>>(grid, cart_.dims(), cart_.coords(),
                                                         rows_below, rows_above);

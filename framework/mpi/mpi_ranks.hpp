@@ -28,7 +28,8 @@ class MpiRanks : public Ranks<D> {
   const HaloExchange<D>* halo() const { return halo_.get(); }
   const ParticleMigration<D>* migration() const { return migration_.get(); }
 
-  std::string decompose(Grid<D>& grid, int rows_below, int rows_above, int threads) override;
+  std::string decompose(Grid<D>& grid, int rows_below, int rows_above, int threads,
+                        const std::array<bool, D>& whole) override;
   typename Ranks<D>::CellBlock cell_block(const Grid<D>& grid) const override;
   bool split() const override { return decomposition_ != nullptr; }
   void complete_nodes(const std::vector<NodalArray>& arrays) override;

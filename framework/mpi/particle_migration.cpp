@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include "mpi_error.hpp"
 
@@ -54,6 +55,7 @@ ParticleMigration<D>::ParticleMigration(MPI_Comm comm, const Decomposition<D>& d
     l.recv_tag = direction_tag<D>(l.offset, -1);
     links_.push_back(std::move(l));
   }
+  for (int d = 0; d < D; ++d) std::tie(own_lo_[d], own_hi_[d]) = dec_.cells_of(dec_.coords(), d);
 }
 
 template <int D>
@@ -80,24 +82,40 @@ int ParticleMigration<D>::link_of(const std::array<int, D>& cell) const {
 }
 
 template <int D>
+bool ParticleMigration<D>::in_own_block(const Particles<D>& P, size_t i) const {
+  for (int d = 0; d < D; ++d) {
+    const int c = grid_.cell_of(P.col(P.position, d)[i], d);
+    if (c < own_lo_[d] || c >= own_hi_[d]) return false;
+  }
+  return true;
+}
+
+template <int D>
 long ParticleMigration<D>::migrate(Particles<D>& P) {
   const int per = values_per_particle(P);
   long strays = 0;
   first_stray_ = -1;
   for (auto& l : links_) l.send.clear();
-  std::vector<uint8_t> leaving(P.size(), 0);
-  for (size_t i = 0; i < P.size(); ++i) {
+  // Which particles leave: a threaded test against the own block (almost every particle stays),
+  // then the leavers, in index order, packed by the master thread.
+  const long n = long(P.size());
+  long leaving_count = 0;
+  leaving_.assign(P.size(), 0);
+#pragma omp parallel for reduction(+ : leaving_count) schedule(static)
+  for (long i = 0; i < n; ++i)
+    if (!in_own_block(P, size_t(i))) leaving_[size_t(i)] = 1, ++leaving_count;
+  for (long i = 0; leaving_count > 0 && i < n; ++i) {
+    if (!leaving_[size_t(i)]) continue;
     std::array<int, D> cell{};
-    for (int d = 0; d < D; ++d) cell[d] = grid_.cell_of(P.col(P.position, d)[i], d);
+    for (int d = 0; d < D; ++d) cell[d] = grid_.cell_of(P.col(P.position, d)[size_t(i)], d);
     const int k = link_of(cell);
-    if (k == -1) continue;
     if (k == -2) {  // kept here and reported: the other ranks are already on their way to receive
-      if (strays == 0) first_stray_ = long(P.id[i]);
+      if (strays == 0) first_stray_ = long(P.id[size_t(i)]);
       ++strays;
+      leaving_[size_t(i)] = 0;
       continue;
     }
-    pack_particle(P, i, links_[size_t(k)].send);
-    leaving[i] = 1;
+    pack_particle(P, size_t(i), links_[size_t(k)].send);
     particles_ += 1;
   }
   // Post every send (one per neighbour, empty ones included: the receiver waits for it), then
@@ -124,7 +142,7 @@ long ParticleMigration<D>::migrate(Particles<D>& P) {
         "MPI_Recv");
   }
   mpi_check(MPI_Waitall(int(sends.size()), sends.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
-  P.erase(leaving);
+  if (leaving_count > strays) P.erase(leaving_);
   size_t arriving = 0;
   for (const auto& l : links_) arriving += l.recv.size() / size_t(per);
   size_t i = P.size();

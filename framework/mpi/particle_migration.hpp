@@ -49,10 +49,14 @@ class ParticleMigration {
     std::vector<double> send, recv;
   };
   std::vector<Link> links_;
+  std::array<int, D> own_lo_{}, own_hi_{};  // this rank's cells [lo, hi) per axis
+  std::vector<uint8_t> leaving_;            // per particle: 1 if it is sent away
   long particles_ = 0, messages_ = 0, bytes_ = 0, first_stray_ = -1;
 
   /// The link to the rank owning cell `cell`, or -1 for this rank; -2 outside the neighbourhood.
   int link_of(const std::array<int, D>& cell) const;
+  /// Whether particle i is in a cell of this rank.
+  bool in_own_block(const Particles<D>& P, size_t i) const;
 };
 
 }  // namespace loam

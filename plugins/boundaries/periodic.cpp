@@ -51,6 +51,10 @@ class Periodic : public Boundary<D> {
     // A face another condition holds: Simulation::check_periodic_faces (after every set-up).
   }
   int periodic_axis() const override { return axis_; }
+  /// Under mpirun no block boundary cuts the axis (Ranks::decompose keeps it whole), so each
+  /// rank holds both faces of its stored nodes, pairwise, and joins them after the nodal sums
+  /// are complete.
+  bool runs_on_ranks() const override { return true; }
 
   /// The join: mass, momentum and force of each pair summed into both nodes.
   void add_forces(const GridForces& g) const override {

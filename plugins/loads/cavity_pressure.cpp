@@ -16,6 +16,7 @@
 // samples with no body particle within 2 s. Normals and areas are those of the reference
 // configuration (a nominal pressure, as `traction`'s); the forces act at the particle centres.
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 
@@ -75,6 +76,9 @@ class CavityPressure : public Load<D> {
         level_(p.present("level") ? p.real("level") : 0.0),
         time_(p) {}
   bool uses_particle_forces() const override { return true; }
+  /// Every rank holds the whole wall's loaded ids and forces and applies those of its own
+  /// particles (assign_samples).
+  bool runs_on_ranks() const override { return true; }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     const int b = sim.body_param(params_, "body", diag);
@@ -124,16 +128,18 @@ class CavityPressure : public Load<D> {
     return c;
   }
 
+  /// The body's particles inside the cavity, over all ranks.
   size_t count_inside(const Simulation<D>& sim, int b) const {
     const auto& P = sim.sets[size_t(set_)].particles;
-    size_t n = 0;
+    double n = 0;
     for (size_t i = 0; i < P.size(); ++i) {
       if (P.body[i] != b) continue;
       std::array<double, D> x{};
       for (int d = 0; d < D; ++d) x[size_t(d)] = P.col(P.position, d)[i];
       n += cavity_->contains(x);
     }
-    return n;
+    sim.ranks->sum(&n, 1);
+    return size_t(n);
   }
 
   /// Pressure at a wall sample (before the time factor).
@@ -142,7 +148,10 @@ class CavityPressure : public Load<D> {
   }
 
   /// Each wall sample's force p(x_q) A_q n_q to the nearest body particle (within 2 s), found
-  /// through a hash of the particles near the cavity by cells of size s.
+  /// through a hash of the particles near the cavity by cells of size s. Under mpirun each rank
+  /// finds its own nearest particle of every sample, the ranks' candidates are gathered, and
+  /// every rank keeps the whole wall's loaded ids and forces (a particle keeps its load when
+  /// it changes rank).
   void assign_samples(const Simulation<D>& sim, int b, const Generator<D>& region,
                       const std::vector<typename Generator<D>::SurfaceSample>& wall, double s) {
     const auto& P = sim.sets[size_t(set_)].particles;
@@ -159,15 +168,16 @@ class CavityPressure : public Load<D> {
       }
       if (close) near[cell_of(x, s)].push_back(i);
     }
-    std::map<size_t, std::array<double, D>> share;  // particle index -> sum p_q A_q n_q
+    std::vector<const typename Generator<D>::SurfaceSample*> samples;
+    std::vector<double> mine;  // per sample: this rank's nearest particle (r2, setup_order)
     for (const auto& q : wall) {
       std::array<double, D> outside{};
       for (int d = 0; d < D; ++d)
         outside[size_t(d)] = q.x[size_t(d)] + 0.5 * s * q.normal[size_t(d)];
       if (!region.contains(outside)) continue;  // not on this body's wall
+      // The nearest particle within 2 s: (r2, setup_order), smallest first.
       const Cell c = cell_of(q.x, s);
-      size_t best = SIZE_MAX;
-      double best_r2 = 4 * s * s;
+      std::array<double, 4> best{std::numeric_limits<double>::infinity(), 0, 0, 0};
       for (int k = 0; k < int(std::pow(5, D)); ++k) {  // the cells within 2 of c
         Cell n = c;
         for (int d = 0, r = k; d < D; ++d, r /= 5) n[size_t(d)] += r % 5 - 2;
@@ -179,16 +189,26 @@ class CavityPressure : public Load<D> {
             const double e = P.col(P.position, d)[i] - q.x[size_t(d)];
             r2 += e * e;
           }
-          if (r2 < best_r2 || (r2 == best_r2 && i < best)) best_r2 = r2, best = i;
+          if (r2 > 4 * s * s) continue;
+          const auto order = setup_order(P, sim.grid, i);
+          const std::array<double, 4> cand{r2, order[0], order[1], order[2]};
+          if (cand < best) best = cand;
         }
       }
-      if (best == SIZE_MAX) continue;
-      auto& a = share[best];
+      samples.push_back(&q);
+      mine.insert(mine.end(), best.begin(), best.end());
+    }
+    const std::vector<double> nearest = smallest_over_ranks(*sim.ranks, mine, 4, 4);
+    std::map<uint32_t, std::array<double, D>> share;  // particle id -> sum p_q A_q n_q
+    for (size_t k = 0; k < samples.size(); ++k) {
+      if (nearest[4 * k] == std::numeric_limits<double>::infinity()) continue;  // none within 2 s
+      const auto& q = *samples[k];
+      auto& a = share[uint32_t(nearest[4 * k + 3])];
       const double pa = pressure_at(q.x) * q.area;
       for (int d = 0; d < D; ++d) a[size_t(d)] += pa * q.normal[size_t(d)];
     }
-    for (const auto& [i, a] : share) {
-      ids_.push_back(P.id[i]);
+    for (const auto& [id, a] : share) {
+      ids_.push_back(id);
       force_.push_back(a);
     }
   }

@@ -28,6 +28,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <tuple>
 
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
@@ -96,23 +97,35 @@ class BlastWave : public Reference<D> {
     }
   }
 
+  /// Each probe's particle is sampled by the rank that holds it; the others give zeros, and one
+  /// sum over the ranks hands every rank the values (exact: one term is not zero).
   void sample(Simulation<D>& sim) override {
     time_.push_back(sim.time);
-    for (auto& pr : probes_) {
+    constexpr int kValues = 5;  // |v|^2, |u|^2, p, q, plastic strain
+    std::vector<double> v(probes_.size() * kValues, 0.0);
+    for (size_t k = 0; k < probes_.size(); ++k) {
+      const Probe& pr = probes_[k];
       const auto& set = sim.sets[size_t(pr.set)];
       const auto& P = set.particles;
       const size_t i = set.index_of(pr.id);
-      double v2 = 0, u2 = 0;
+      if (i == set.npos) continue;  // on another rank
+      double* out = &v[k * kValues];
       for (int d = 0; d < D; ++d) {
-        v2 += std::pow(P.col(P.velocity, d)[i], 2);
-        u2 += std::pow(P.col(P.position, d)[i] - pr.x0[size_t(d)], 2);
+        out[0] += std::pow(P.col(P.velocity, d)[i], 2);
+        out[1] += std::pow(P.col(P.position, d)[i] - pr.x0[size_t(d)], 2);
       }
-      const auto [p, q] = invariants(P, i);
-      pr.speed.push_back(std::sqrt(v2));
-      pr.displacement.push_back(std::sqrt(u2));
-      pr.p.push_back(p);
-      pr.q.push_back(q);
-      pr.plastic = pr.eq >= 0 ? P.col(pr.eq)[i] : 0.0;
+      std::tie(out[2], out[3]) = invariants(P, i);
+      out[4] = pr.eq >= 0 ? P.col(pr.eq)[i] : 0.0;
+    }
+    sim.ranks->sum(v.data(), int(v.size()));
+    for (size_t k = 0; k < probes_.size(); ++k) {
+      Probe& pr = probes_[k];
+      const double* in = &v[k * kValues];
+      pr.speed.push_back(std::sqrt(in[0]));
+      pr.displacement.push_back(std::sqrt(in[1]));
+      pr.p.push_back(in[2]);
+      pr.q.push_back(in[3]);
+      pr.plastic = in[4];
       if (time_.size() == 1) pr.plastic0 = pr.plastic;
     }
   }
@@ -157,6 +170,9 @@ class BlastWave : public Reference<D> {
     return s;
   }
 
+  /// Every rank holds every probe's series (sample).
+  bool runs_on_ranks() const override { return true; }
+
   bool save_state(std::vector<double>& s) const override {
     s.push_back(double(time_.size()));
     s.insert(s.end(), time_.begin(), time_.end());
@@ -193,34 +209,48 @@ class BlastWave : public Reference<D> {
     std::vector<double> speed, displacement, p, q;
   };
 
-  /// The P-wave speed the body's material gives its first particle.
+  /// The P-wave speed the body's material gives its first particle (in the set-up order, over
+  /// all ranks: setup_order).
   static double p_wave_speed(const Simulation<D>& sim, int b) {
     const auto& P = sim.particles_of_body(b);
+    std::vector<double> first{std::numeric_limits<double>::infinity(), 0, 0, std::nan("")};
     for (size_t i = 0; i < P.size(); ++i)
-      if (P.body[i] == b) return sim.materials[P.material[i]]->wave_speed(P, i, i + 1);
-    return std::nan("");
+      if (P.body[i] == b) {
+        const auto order = setup_order(P, sim.grid, i);
+        first = {order[0], order[1], order[2],
+                 sim.materials[P.material[i]]->wave_speed(P, i, i + 1)};
+        break;
+      }
+    return smallest_over_ranks(*sim.ranks, first, 4, 3)[3];
   }
 
-  /// The particle of body_ or cover_ nearest to `target` at set-up.
+  /// The particle of body_ or cover_ nearest to `target` at set-up: of equally near ones body_'s
+  /// before cover_'s, then the first in the set-up order (setup_order), over all ranks.
   bool nearest(const Simulation<D>& sim, const std::array<double, D>& target, Probe& pr) const {
-    double best = INFINITY;
-    for (int b : {body_, cover_}) {
+    // r2, which body (0: body_, 1: cover_), setup_order (3), then the position.
+    std::vector<double> best(5 + D, 0.0);
+    best[0] = std::numeric_limits<double>::infinity();
+    for (int which : {0, 1}) {
+      const int b = which == 0 ? body_ : cover_;
       if (b < 0) continue;
-      const int si = sim.body_set(b);
-      const auto& P = sim.sets[size_t(si)].particles;
+      const auto& P = sim.sets[size_t(sim.body_set(b))].particles;
       for (size_t i = 0; i < P.size(); ++i) {
         if (P.body[i] != b) continue;
         double r2 = 0;
         for (int d = 0; d < D; ++d) r2 += std::pow(P.col(P.position, d)[i] - target[size_t(d)], 2);
-        if (r2 >= best) continue;
-        best = r2;
-        pr.set = si;
-        pr.body = b;
-        pr.id = P.id[i];
-        for (int d = 0; d < D; ++d) pr.x0[size_t(d)] = P.col(P.position, d)[i];
+        if (r2 >= best[0]) continue;  // the first of equally near ones in this rank's order
+        const auto order = setup_order(P, sim.grid, i);
+        best = {r2, double(which), order[0], order[1], order[2]};
+        for (int d = 0; d < D; ++d) best.push_back(P.col(P.position, d)[i]);
       }
     }
-    return std::isfinite(best);
+    best = smallest_over_ranks(*sim.ranks, best, 5 + D, 5);
+    if (!std::isfinite(best[0])) return false;
+    pr.body = best[1] == 0 ? body_ : cover_;
+    pr.set = sim.body_set(pr.body);
+    pr.id = uint32_t(best[4]);
+    for (int d = 0; d < D; ++d) pr.x0[size_t(d)] = best[5 + size_t(d)];
+    return true;
   }
 
   static double distance(const std::array<double, D>& a, const std::array<double, D>& b) {

@@ -6,7 +6,9 @@
 //
 // Under mpirun (docs/parallel.md) each rank writes its own particles of a frame,
 // <set>_NNNNNN_rRRRR.h5, and the first rank the index, in which each frame is a spatial
-// collection of the ranks' pieces: ParaView opens it as one dataset per frame.
+// collection of the ranks' pieces: ParaView opens it as one dataset per frame. With `grid`,
+// each rank's piece of the first set also holds the grid nodes it owns, and the grid's frames
+// are spatial collections of those.
 #include <hdf5.h>
 
 #include <nlohmann/json.hpp>
@@ -58,6 +60,7 @@ class Xdmf : public Writer<D> {
                       {"grid_nodes", f.grid_nodes},
                       {"grid_attributes", attrs(f.grid_attributes)}});
         if (!f.pieces.empty()) js.back()["pieces"] = f.pieces;
+        if (!f.grid_pieces.empty()) js.back()["grid_pieces"] = f.grid_pieces;
       }
       j.push_back(js);
     }
@@ -75,7 +78,8 @@ class Xdmf : public Writer<D> {
         };
         frames_[s].push_back(Frame{f["file"], f["time"], f["step"], f["n"], attrs(f["attributes"]),
                                    f["grid_nodes"], attrs(f["grid_attributes"]),
-                                   f.value("pieces", std::vector<long>{})});
+                                   f.value("pieces", std::vector<long>{}),
+                                   f.value("grid_pieces", std::vector<long>{})});
       }
   }
 
@@ -98,7 +102,8 @@ class Xdmf : public Writer<D> {
     std::vector<Attribute> attributes;
     size_t grid_nodes = 0;
     std::vector<Attribute> grid_attributes;
-    std::vector<long> pieces;  // under mpirun, each rank's particle count (first rank only)
+    std::vector<long> pieces;       // under mpirun, each rank's particle count (first rank only)
+    std::vector<long> grid_pieces;  // under mpirun, each rank's owned node count (first rank)
   };
   std::string dir_;
   std::vector<int> fields_;
@@ -131,9 +136,11 @@ class Xdmf : public Writer<D> {
     }
     fr.file = stem;
     fr.pieces = ranks.gather(long(set.size()));
+    const bool grid = with_grid_ && s == 0;
+    if (grid) fr.grid_pieces = ranks.gather(long(fr.grid_nodes));
     if (!error.empty()) throw WriteError(failed_file, error);
     frames_[s].push_back(fr);
-    if (ranks.root()) write_index(set.name, frames_[s], false);
+    if (ranks.root()) write_index(set.name, frames_[s], grid);
   }
 
   /// This process's particles of a set as the HDF5 file `name` in the directory.
@@ -148,7 +155,7 @@ class Xdmf : public Writer<D> {
     hid_t f = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     if (f < 0) fail(file, tmp);
     ok_ = true;
-    Frame fr{name, sim.time, sim.step, n, {}, 0, {}, {}};
+    Frame fr{name, sim.time, sim.step, n, {}, 0, {}, {}, {}};
     write_columns(f, "position", P, P.position, 3);
     std::vector<int> ids(n);
     for (size_t i = 0; i < n; ++i) ids[i] = int(P.id[i]);
@@ -203,20 +210,28 @@ class Xdmf : public Writer<D> {
     write_dataset(f, name, buf.data(), n, width, H5T_NATIVE_DOUBLE);
   }
 
+  /// The grid's nodes with the scheme's nodal fields (grid_position, grid_<field>). Under
+  /// mpirun each rank writes the nodes it owns (Ranks::owns_node: every node once over the
+  /// ranks; every stored copy holds the whole grid's value after the step).
   void write_grid(hid_t f, Simulation<D>& sim, Frame& fr) {
     const auto& g = sim.grid;
-    std::vector<double> xyz(g.num_nodes * 3, 0.0);
+    std::vector<size_t> nodes;
     for (size_t n = 0; n < g.num_nodes; ++n)
-      for (int d = 0; d < D; ++d) xyz[n * 3 + size_t(d)] = g.node_coord(n, d);
-    write_dataset(f, "grid_position", xyz.data(), g.num_nodes, 3, H5T_NATIVE_DOUBLE);
-    fr.grid_nodes = g.num_nodes;
+      if (!sim.ranks->distributed() || sim.ranks->owns_node(g, g.node_ijk(n))) nodes.push_back(n);
+    const size_t count = nodes.size();
+    std::vector<double> xyz(count * 3, 0.0);
+    for (size_t k = 0; k < count; ++k)
+      for (int d = 0; d < D; ++d) xyz[k * 3 + size_t(d)] = g.node_coord(nodes[k], d);
+    write_dataset(f, "grid_position", xyz.data(), count, 3, H5T_NATIVE_DOUBLE);
+    fr.grid_nodes = count;
     for (const auto& v : sim.scheme->grid_fields()) {
       const int width = v.components == D && D > 1 ? 3 : v.components;  // pad 2D vectors
-      std::vector<double> buf(g.num_nodes * size_t(width), 0.0);
-      for (size_t n = 0; n < g.num_nodes; ++n)
+      std::vector<double> buf(count * size_t(width), 0.0);
+      for (size_t k = 0; k < count; ++k)
         for (int c = 0; c < v.components; ++c)
-          buf[n * size_t(width) + size_t(c)] = v.base[n * size_t(v.stride) + size_t(v.offset + c)];
-      write_dataset(f, "grid_" + v.name, buf.data(), g.num_nodes, width, H5T_NATIVE_DOUBLE);
+          buf[k * size_t(width) + size_t(c)] =
+              v.base[nodes[k] * size_t(v.stride) + size_t(v.offset + c)];
+      write_dataset(f, "grid_" + v.name, buf.data(), count, width, H5T_NATIVE_DOUBLE);
       fr.grid_attributes.push_back({v.name, width, "Float"});
     }
   }
@@ -269,8 +284,19 @@ class Xdmf : public Writer<D> {
     x << "    </Grid>\n";
     if (grid) {
       x << "    <Grid Name=\"grid\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-      for (const auto& fr : frames)
-        polyvertex(x, "grid", fr.file, "grid_", fr.grid_nodes, fr.grid_attributes, fr.time);
+      for (const auto& fr : frames) {
+        if (fr.grid_pieces.empty()) {
+          polyvertex(x, "grid", fr.file, "grid_", fr.grid_nodes, fr.grid_attributes, fr.time);
+          continue;
+        }
+        x << "      <Grid Name=\"grid\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
+          << "        <Time Value=\"" << fr.time << "\"/>\n";
+        for (size_t r = 0; r < fr.grid_pieces.size(); ++r)
+          if (fr.grid_pieces[r] > 0)
+            polyvertex(x, "grid" + rank_tag(int(r)), fr.file + rank_tag(int(r)) + ".h5", "grid_",
+                       size_t(fr.grid_pieces[r]), fr.grid_attributes, fr.time, true);
+        x << "      </Grid>\n";
+      }
       x << "    </Grid>\n";
     }
     x << "  </Domain>\n</Xdmf>\n";

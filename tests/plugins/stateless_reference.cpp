@@ -1,7 +1,8 @@
 // A test-only out-of-tree plugin (tests/test_checkpoint.cpp): a reference that keeps a running
 // state (the largest particle speed seen) but does not implement save_state, as a plugin
 // written before checkpoints existed would. A checkpointed run with it must be refused at
-// set-up: resuming it would silently restart its state from zero.
+// set-up: resuming it would silently restart its state from zero. Nor does it declare
+// runs_on_ranks: under mpirun it is refused where the file names it (tests/test_mpi_runs.cpp).
 #include <algorithm>
 #include <cmath>
 
