@@ -116,23 +116,24 @@ class Ranks {
   virtual void barrier() const {}
 };
 
-/// Sums over all ranks of the given numbers, in place (one reduction for all of them; every
-/// rank calls it with the same list): sum_over_ranks(ranks, volume, count). Counts go through
-/// doubles, exact below 2^53.
-template <int D, class... T>
-void sum_over_ranks(const Ranks<D>& ranks, T&... values) {
+/// Reduce the given numbers over all ranks in place with `reduce(double*, n)`, one call for all
+/// of them (every rank passes the same list). Counts go through doubles, exact below 2^53.
+template <class Reduce, class... T>
+void reduce_over_ranks(Reduce&& reduce, T&... values) {
   double all[] = {double(values)...};
-  ranks.sum(all, int(sizeof...(T)));
+  reduce(all, int(sizeof...(T)));
   size_t k = 0;
   ((values = T(all[k++])), ...);
+}
+/// Sums over all ranks of the given numbers, in place: sum_over_ranks(ranks, volume, count).
+template <int D, class... T>
+void sum_over_ranks(const Ranks<D>& ranks, T&... values) {
+  reduce_over_ranks([&](double* v, int n) { ranks.sum(v, n); }, values...);
 }
 /// Maxima over all ranks of the given numbers, in place (as sum_over_ranks).
 template <int D, class... T>
 void max_over_ranks(const Ranks<D>& ranks, T&... values) {
-  double all[] = {double(values)...};
-  ranks.max(all, int(sizeof...(T)));
-  size_t k = 0;
-  ((values = T(all[k++])), ...);
+  reduce_over_ranks([&](double* v, int n) { ranks.max(v, n); }, values...);
 }
 
 /// Per item, the candidate whose first `key` values are lexicographically smallest over all

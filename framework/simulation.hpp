@@ -228,6 +228,19 @@ class Simulation {
     for (auto& s : sets) s.gather_blocks([&](size_t b, int c, int t) { f(s, b, c, t); });
   }
 
+  /// A particle load's forces: external_force += force(k, d) for every particle ids[k] of set
+  /// `set` that is here (a body waiting for a stage is not; under mpirun, another rank's
+  /// particle is not). Loads that keep their particles by id (traction, cavity_pressure).
+  template <class F>
+  void add_external_forces(int set, const std::vector<uint32_t>& ids, F&& force) {
+    ParticleSet<D>& s = sets[size_t(set)];
+    for (size_t k = 0; k < ids.size(); ++k) {
+      const size_t i = s.index_of(ids[k]);
+      if (i == s.npos) continue;
+      for (int d = 0; d < D; ++d) s.particles.col(external_force, d)[i] += force(k, d);
+    }
+  }
+
   // --------------------------------------------------------- particle fields
   /// Register a particle field in every set (one layout: the handle is valid in each) and
   /// allocate it in all of them, or only in set `only` (e.g. a material's state in the set of

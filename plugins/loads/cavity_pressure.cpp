@@ -111,13 +111,7 @@ class CavityPressure : public Load<D> {
 
   void apply_to_particles(Simulation<D>& sim, double t) override {
     const double f = time_(t);
-    auto& set = sim.sets[size_t(set_)];
-    auto& P = set.particles;
-    for (size_t k = 0; k < ids_.size(); ++k) {
-      const size_t i = set.index_of(ids_[k]);
-      if (i == set.npos) continue;  // not in the run (its body waits for a stage)
-      for (int d = 0; d < D; ++d) P.col(sim.external_force, d)[i] += f * force_[k][size_t(d)];
-    }
+    sim.add_external_forces(set_, ids_, [&](size_t k, int d) { return f * force_[k][size_t(d)]; });
   }
 
  private:

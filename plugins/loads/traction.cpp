@@ -137,13 +137,8 @@ class Traction : public Load<D> {
   void apply_to_particles(Simulation<D>& sim, double t) override {
     if (surface_) return;
     const double s = time_(t);
-    auto& set = sim.sets[size_t(set_)];
-    auto& P = set.particles;
-    for (size_t k = 0; k < ids_.size(); ++k) {
-      const size_t i = set.index_of(ids_[k]);
-      if (i == set.npos) continue;  // not in the run (its body waits for a stage)
-      for (int d = 0; d < D; ++d) P.col(sim.external_force, d)[i] += s * t_[size_t(d)] * area_[k];
-    }
+    sim.add_external_forces(set_, ids_,
+                            [&](size_t k, int d) { return s * t_[size_t(d)] * area_[k]; });
   }
 
  private:
