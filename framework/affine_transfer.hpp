@@ -14,11 +14,16 @@
 // gives x_I - x_p and D_p = diag(sum_j w_j dx_j^2) per axis from its axis values
 // (axis_stencil.hpp; h^2/4 per axis for interior quadratic B-splines), vectorised over the
 // block; for CPDI (and the offsets of linear tents) they come from the node coordinates, with
-// D_p's sum and inverse per particle (invertible: a domain spans nodes). Keeping B_p, not
-// C_p = B_p D_p^-1, and taking D_p where the particle is when it scatters is what conserves
-// angular momentum over the move for weights whose D_p changes with position. Linear and angular
-// momentum are conserved by the transfers; the affine part carries no PIC dissipation and no
-// FLIP noise (tests/test_apic.cpp).
+// D_p's sum and inverse per particle (invertible: a domain spans nodes). On a tensor-product
+// stencil (M nodes per axis, entry k at axis node i_e(k) along axis e) the offsets are kept per
+// axis and the per-entry affine algebra factors over the axes: the P2G's m C (x_I - x_p) is
+// sum_e mC_:e dx_e(i_e), a sum of D per-axis terms formed once per particle (Momenta), and the
+// G2P's B_de = sum_k w_k v_k,d dx_e(i_e(k)) = sum_i dx_e(i) S_e(i)_d, where S_e(i) sums w_k v_k
+// over the entries at axis node i (MomentSum): additions per entry instead of D^2 products. Keeping
+// B_p, not C_p = B_p D_p^-1, and taking D_p where the particle is when it scatters is what
+// conserves angular momentum over the move for weights whose D_p changes with position. Linear and
+// angular momentum are conserved by the transfers; the affine part carries no PIC dissipation and
+// no FLIP noise (tests/test_apic.cpp).
 //
 // Multilinear tents (shape functions whose stencil does not cover the particle's domain) are the
 // exception: there N_Ip D_p^-1 (x_I - x_p) = grad N_Ip (Jiang et al. 2015, section 5.3) does not
@@ -65,15 +70,56 @@ class AffineTransfer {
 
   /// x_I - x_p of every stencil entry of a particle, and D_p^-1 (APIC's B_p form only).
   struct Stencil {
-    /// x_I - x_p of entry k along axis j: in the stencil block (its SoA layout, no copy) or
-    /// in `own` (computed from the node coordinates).
+    /// x_I - x_p of entry k along axis j: per axis in the stencil block (its layout, no copy;
+    /// m nodes per axis, entry k is axis node (k / m^j) % m along j) or per entry in `own`
+    /// (m = 0, computed from the node coordinates).
     LOAM_FORCE_INLINE double dx(int k, int j) const {
-      return at[(size_t(k) * D + size_t(j)) * stride];
+      if (m == 0) return at[(size_t(k) * D + size_t(j)) * stride];
+      for (int e = 0; e < j; ++e) k /= m;
+      return axis(j, k % m);
+    }
+    /// The offset of axis node i along axis j (m > 0: the block's layout, stride kBlock).
+    LOAM_FORCE_INLINE double axis(int j, int i) const {
+      return at[(size_t(j) * size_t(m) + size_t(i)) * kBlock];
+    }
+    template <int M>
+    LOAM_FORCE_INLINE double axis(int j, int i) const {
+      return at[(size_t(j) * M + size_t(i)) * kBlock];
     }
     const double* at = own;
     size_t stride = 1;
+    int m = 0;                         // nodes per axis of a tensor-product stencil, else 0
     double own[kMaxEntries * D] = {};  // value-initialised: declared once per block
     double inertia_inv[D][D] = {};
+  };
+
+  /// Nodes per axis of a tensor-product stencil of NPP entries (NPP = M^D), 0 if none: the
+  /// product form of the affine sums below is compiled for it.
+  static constexpr int axis_nodes_of(int npp) {
+    for (int m = 2; m <= 4; ++m)
+      if (ipow(m, D) == npp) return m;
+    return 0;
+  }
+
+  /// One particle's sum for APIC's B_p (or TPIC's C_p) over its stencil entries, while the
+  /// G2P gathers them (add_moment, then moment). On a tensor-product stencil B_p's sum
+  /// factors: B_de = sum_k w_k v_k,d dx_e(k) = sum_i dx_e(i) S_e(i)_d, where S_e(i) sums w_k v_k
+  /// over the entries at axis node i along e, so an entry costs D^2 additions instead of D^2
+  /// products and additions.
+  /// Cleared per particle (clear) by the pass that sums it, so that a FLIP pass declaring
+  /// one pays nothing.
+  template <int NPP>
+  struct MomentSum {
+    static constexpr int M = axis_nodes_of(NPP);
+    double axis[D][M > 0 ? M : 1][D];  // S_e(i): the product form
+    double B[D][D];                    // per entry: CPDI, node coordinates, TPIC
+    LOAM_FORCE_INLINE void clear() {
+      for (int e = 0; e < D; ++e)
+        for (int i = 0; i < (M > 0 ? M : 1); ++i)
+          for (int d = 0; d < D; ++d) axis[e][i][d] = 0.0;
+      for (int d = 0; d < D; ++d)
+        for (int j = 0; j < D; ++j) B[d][j] = 0.0;
+    }
   };
 
   /// The transfer's name in a scheme's `transfer` key: apic or tpic.
@@ -123,6 +169,7 @@ class AffineTransfer {
     }
     a.at = st.dx.data() + p;
     a.stride = kBlock;
+    a.m = st.axis_nodes;
     if (gradient_form_) return;
     for (int d = 0; d < D; ++d)
       for (int j = 0; j < D; ++j)
@@ -137,6 +184,7 @@ class AffineTransfer {
     for (int d = 0; d < D; ++d) xp[d] = P.col(P.position, d)[i];
     a.at = a.own;
     a.stride = 1;
+    a.m = 0;
     Eigen::Matrix<double, D, D> inertia = Eigen::Matrix<double, D, D>::Zero();
     for (int k = 0; k < npp; ++k) {
       const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -159,7 +207,8 @@ class AffineTransfer {
     for (int d = 0; d < D; ++d)
       for (int j = 0; j < D; ++j) B[d][j] = P.col(field, d * D + j)[i];
   }
-  static void store(Particles<D>& P, int field, size_t i, const double (&B)[D][D]) {
+  LOAM_FORCE_INLINE static void store(Particles<D>& P, int field, size_t i,
+                                      const double (&B)[D][D]) {
     for (int d = 0; d < D; ++d)
       for (int j = 0; j < D; ++j) P.col(field, d * D + j)[i] = B[d][j];
   }
@@ -180,6 +229,11 @@ class AffineTransfer {
         for (int j = 0; j < D; ++j) mC[d][j] = mp * B[d][j];
       return;
     }
+    if (a.m > 0) {  // D_p diagonal (axis_stencil.hpp)
+      for (int d = 0; d < D; ++d)
+        for (int j = 0; j < D; ++j) mC[d][j] = mp * B[d][j] * a.inertia_inv[j][j];
+      return;
+    }
     for (int d = 0; d < D; ++d)
       for (int j = 0; j < D; ++j) {
         double c = 0;
@@ -188,35 +242,97 @@ class AffineTransfer {
       }
   }
 
-  /// The momentum stencil entry k sends to its node, w (m v_p + (m B D^-1)(x_I - x_p)), added
-  /// to the node's slot r (D values).
-  LOAM_FORCE_INLINE static void add_momentum(double w, const Stencil& s, int k,
-                                             const double (&mv)[D], const double (&mC)[D][D],
-                                             double* r) {
-    double dx[D];
-    for (int j = 0; j < D; ++j) dx[j] = s.dx(k, j);
-    for (int d = 0; d < D; ++d) {
-      double a = mv[d];
-      for (int j = 0; j < D; ++j) a += mC[d][j] * dx[j];
-      r[d] += w * a;
+  /// The momentum per unit weight each stencil entry k of a particle sends to its node, a_k =
+  /// m v_p + (m B D^-1)(x_I - x_p) (the scatter adds w_k a_k; momenta fills it). On a
+  /// tensor-product stencil the affine part is a sum over the axes, a_k = sum_e t_e(i_e(k)) with
+  /// t_0(i) = m v_p + mC_:0 dx_0(i) and t_e(i) = mC_:e dx_e(i): D (D - 1) additions per entry,
+  /// done where the scatter reads it (unrolled, i_e(k) are constants); the same bits as the
+  /// per-entry sum m v_p + mC_:0 dx_0 + mC_:1 dx_1 + ...
+  template <int NPP>
+  struct Momenta {
+    static constexpr int M = axis_nodes_of(NPP);
+    bool product = false;
+    double t[D][M > 0 ? M : 1][D] = {};  // the product form: t_e(i) (declare once per block)
+    double a[NPP > 0 ? NPP : kMaxEntries][D] = {};  // per entry (CPDI, node coordinates)
+    LOAM_FORCE_INLINE double at(int k, int d) const {
+      if constexpr (M > 0) {
+        if (product) {
+          double v = t[0][k % M][d];
+          for (int e = 1, r = k / M; e < D; ++e, r /= M) v += t[e][r % M][d];
+          return v;
+        }
+      }
+      return a[k][d];
     }
+  };
+  template <int NPP>
+  LOAM_FORCE_INLINE static void momenta(const Stencil& s, int npp, const double (&mv)[D],
+                                        const double (&mC)[D][D], Momenta<NPP>& out) {
+    constexpr int M = Momenta<NPP>::M;
+    if constexpr (M > 0) {
+      out.product = s.m == M;
+      if (out.product) {
+        for (int e = 0; e < D; ++e)
+          for (int i = 0; i < M; ++i) {
+            const double x = s.template axis<M>(e, i);
+            for (int d = 0; d < D; ++d)
+              out.t[e][i][d] = e == 0 ? mv[d] + mC[d][0] * x : mC[d][e] * x;
+          }
+        return;
+      }
+    }
+    for (int k = 0; k < npp; ++k)
+      for (int d = 0; d < D; ++d) {
+        double v = mv[d];
+        for (int j = 0; j < D; ++j) v += mC[d][j] * s.dx(k, j);
+        out.a[k][d] = v;
+      }
   }
 
-  /// G2P of stencil entry k of block particle p: APIC's B += w v_I (x_I - x_p)^T, TPIC's
-  /// C += v_I grad N^T (nothing with linear tents, whose C_p the USF gradient pass stores).
-  LOAM_FORCE_INLINE void add_moment(const StencilBlock<D>& st, int k, int p, const double* vI,
-                                    const Stencil& s, double (&B)[D][D]) const {
+  /// G2P of stencil entry k of block particle p, weight w, node velocity v_I: APIC's
+  /// B += w v_I (x_I - x_p)^T (in the product form: MomentSum), TPIC's C += v_I grad N^T
+  /// (nothing with linear tents, whose C_p the USF gradient pass stores).
+  template <int NPP>
+  LOAM_FORCE_INLINE void add_moment(MomentSum<NPP>& sum, const StencilBlock<D>& st, int k, int p,
+                                    double w, const double* vI, const Stencil& s) const {
     if (usf_gradient_) return;
     if (gradient_form_) {
       for (int j = 0; j < D; ++j) {
         const double g = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
-        for (int d = 0; d < D; ++d) B[d][j] += vI[d] * g;
+        for (int d = 0; d < D; ++d) sum.B[d][j] += vI[d] * g;
       }
       return;
     }
-    const double w = st.w[size_t(k) * kBlock + size_t(p)];
+    constexpr int M = MomentSum<NPP>::M;
+    if constexpr (M > 0) {
+      if (s.m == M) {
+        for (int e = 0, r = k; e < D; ++e, r /= M)
+          for (int d = 0; d < D; ++d) sum.axis[e][r % M][d] += w * vI[d];
+        return;
+      }
+    }
     for (int d = 0; d < D; ++d)
-      for (int j = 0; j < D; ++j) B[d][j] += w * vI[d] * s.dx(k, j);
+      for (int j = 0; j < D; ++j) sum.B[d][j] += w * vI[d] * s.dx(k, j);
+  }
+
+  /// The particle's B_p (or C_p) from its sum over the entries.
+  template <int NPP>
+  LOAM_FORCE_INLINE void moment(const MomentSum<NPP>& sum, const Stencil& s,
+                                double (&B)[D][D]) const {
+    constexpr int M = MomentSum<NPP>::M;
+    if constexpr (M > 0) {
+      if (!gradient_form_ && s.m == M) {
+        for (int d = 0; d < D; ++d)
+          for (int e = 0; e < D; ++e) {
+            double b = 0;
+            for (int i = 0; i < M; ++i) b += sum.axis[e][i][d] * s.template axis<M>(e, i);
+            B[d][e] = b;
+          }
+        return;
+      }
+    }
+    for (int d = 0; d < D; ++d)
+      for (int j = 0; j < D; ++j) B[d][j] = sum.B[d][j];
   }
 
   /// The particle field holding B_p (or C_p), requested only when APIC is on. `name` and

@@ -33,19 +33,29 @@ struct StencilBlock {
   // affine velocity sets `affine` before evaluating: kOffsets asks for x_I - x_p of every entry,
   // kInertia also for D_p^-1. A tensor-product shape function fills them from its per-axis
   // values (framework/axis_stencil.hpp) and sets `has_affine`; for the others AffineTransfer
-  // computes them from the node coordinates.
+  // computes them from the node coordinates. The offsets are kept per axis, as the tensor
+  // product forms them: entry k is axis node (k / M^d) % M along axis d, M = axis_nodes, and
+  // its offset along d is that axis node's (the affine transfers use the product form).
   enum Affine { kNone = 0, kOffsets = 1, kInertia = 2 };
   Affine affine = kNone;
   bool has_affine = false;
-  std::vector<double> dx;           // [(k*D + d)*kBlock + p]: x_I - x_p
+  int axis_nodes = 0;               // M: nodes per axis of the tensor-product stencil
+  std::vector<double> dx;           // [(d*M + j)*kBlock + p]: x_I - x_p of axis node j along d
   std::vector<double> inertia_inv;  // [d*kBlock + p]: 1 / D_p(d, d) (D_p diagonal)
+
+  /// x_I - x_p along axis d of stencil entry k of particle p (has_affine).
+  double offset(int k, int d, int p) const {
+    int j = k;
+    for (int e = 0; e < d; ++e) j /= axis_nodes;
+    return dx[(size_t(d) * size_t(axis_nodes) + size_t(j % axis_nodes)) * kBlock + size_t(p)];
+  }
 
   void allocate(int nodes_per_particle) {
     npp = nodes_per_particle;
     node.assign(size_t(npp) * kBlock, 0);
     w.assign(size_t(npp) * kBlock, 0.0);
     grad.assign(size_t(npp) * D * kBlock, 0.0);
-    dx.assign(size_t(npp) * D * kBlock, 0.0);
+    dx.assign(size_t(npp) * D * kBlock, 0.0);  // D * M <= M^D * D
     inertia_inv.assign(size_t(D) * kBlock, 0.0);
   }
 };

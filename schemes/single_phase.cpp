@@ -187,8 +187,12 @@ class SinglePhase : public Scheme<D> {
   /// (FORCE), all sets summed onto the one node record.
   template <int NPP, bool MOMENTUM, bool FORCE>
   void scatter_all(Simulation<D>& sim) {
+    // APIC's P2G is its own instantiation: the FLIP loop stays as it is without it.
     sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-      scatter<NPP, MOMENTUM, FORCE>(sim, s, b, c, t);
+      if (MOMENTUM && B_ >= 0)
+        scatter<NPP, MOMENTUM, FORCE, true>(sim, s, b, c, t);
+      else
+        scatter<NPP, MOMENTUM, FORCE, false>(sim, s, b, c, t);
     });
   }
   /// G2P velocity update (FLIP/PIC, or APIC's: update_velocity_apic); with REMAP the new
@@ -222,12 +226,14 @@ class SinglePhase : public Scheme<D> {
   }
 
   // ------------------------------------------------------------------ kernels
-  /// Particle-to-grid for one block: mass and momentum (MOMENTUM), forces (FORCE).
-  template <int NPP, bool MOMENTUM, bool FORCE>
-  void scatter(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
+  /// Particle-to-grid for one block: mass and momentum (MOMENTUM; AFFINE: APIC's), forces
+  /// (FORCE).
+  template <int NPP, bool MOMENTUM, bool FORCE, bool AFFINE>
+  [[gnu::noinline]] void scatter(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count,
+                                 int thread) {
     Particles<D>& P = set.particles;
     StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
-    affine_.evaluate(sim, P, b, count, st, MOMENTUM && affine_on_);
+    affine_.evaluate(sim, P, b, count, st, AFFINE);
     const int npp = NPP ? NPP : st.npp;
     const double* m = P.col(P.mass) + b;
     const double* V = P.col(P.volume) + b;
@@ -240,32 +246,31 @@ class SinglePhase : public Scheme<D> {
     for (int c = 0; c < NS; ++c) sig[size_t(c)] = P.col(P.stress, c) + b;
     double* g = node_.data();
     const std::array<double, D> gravity = sim.gravity;
-    const bool affine = MOMENTUM && B_ >= 0;
     typename AffineTransfer<D>::Stencil as;
+    typename AffineTransfer<D>::template Momenta<NPP> am;  // APIC: momenta per unit weight
     for (int p = 0; p < count; ++p) {
       // Particle values in locals: the node stores below could alias the particle columns.
       const double mp = m[p];
-      double mv[D], body[D], sv[D][D], mC[D][D] = {};  // mC: m_p B_p D_p^-1
+      double mv[D], body[D], sv[D][D];
       for (int d = 0; d < D; ++d) {
         mv[d] = mp * v[size_t(d)][p];
         body[d] = mp * gravity[size_t(d)] + (fe[size_t(d)] ? fe[size_t(d)][p] : 0.0);
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * sig[size_t(voigt_index(d, j))][p];
       }
-      if (affine) {
+      if constexpr (AFFINE) {  // APIC: m_p (N v_p + B_p D_p^-1 N (x_I - x_p)), see the header
+        double mC[D][D];       // m_p B_p D_p^-1
         affine_.stencil(P, st, p, b + size_t(p), npp, as);
         affine_.matrix(P, B_, b + size_t(p), mp, as, mC);
+        AffineTransfer<D>::template momenta<NPP>(as, npp, mv, mC, am);
       }
-      for (int k = 0; k < npp; ++k) {
+      // Stencil entry k's share: mass, the momentum per unit weight momentum(d), forces.
+      auto add_entry = [&](int k, auto momentum) __attribute__((always_inline)) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
         double* r = g + size_t(st.node[kp]) * S;
         if constexpr (MOMENTUM) {
           r[kMass] += w * mp;
-          if (affine) {  // APIC: m_p (N v_p + B_p D_p^-1 N (x_I - x_p)), see the header
-            affine_.add_momentum(w, as, k, mv, mC, r + kMomentum);
-          } else {
-            for (int d = 0; d < D; ++d) r[kMomentum + d] += w * mv[d];
-          }
+          for (int d = 0; d < D; ++d) r[kMomentum + d] += w * momentum(d);
         }
         if constexpr (FORCE) {
           double gr[D];
@@ -277,6 +282,13 @@ class SinglePhase : public Scheme<D> {
             r[kForce + d] += f;
           }
         }
+      };
+      if constexpr (AFFINE) {
+        // Unrolled: the product form's axis indices of entry k are then constants.
+#pragma GCC unroll 16
+        for (int k = 0; k < npp; ++k) add_entry(k, [&](int d) { return am.at(k, d); });
+      } else {
+        for (int k = 0; k < npp; ++k) add_entry(k, [&](int d) { return mv[d]; });
       }
     }
   }
@@ -403,17 +415,22 @@ class SinglePhase : public Scheme<D> {
     const HeldFaces<D> walls = sim.held_faces;
     double max_v2 = sc.max_v2;
     typename AffineTransfer<D>::Stencil as;
+    typename AffineTransfer<D>::template Momenta<NPP> am;  // the re-map's momenta per weight
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      double vp[D] = {}, B[D][D] = {};
+      double vp[D] = {}, B[D][D];
+      typename AffineTransfer<D>::template MomentSum<NPP> sum;
+      sum.clear();
       affine_.stencil(P, st, p, i, npp, as);
+#pragma GCC unroll 16
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
         const double* vI = g + size_t(st.node[kp]) * S + kMomentum;
         for (int d = 0; d < D; ++d) vp[d] += w * vI[d];
-        affine_.add_moment(st, k, p, vI, as, B);
+        affine_.add_moment(sum, st, k, p, w, vI, as);
       }
+      affine_.moment(sum, as, B);
       double v2 = 0, mv[D], mC[D][D];
       const double mp = P.col(P.mass)[i];
       if (!affine_.needs_usf()) affine_.store(P, B_, i, B);  // linear: the USF gradient pass
@@ -427,9 +444,12 @@ class SinglePhase : public Scheme<D> {
       max_v2 = std::max(max_v2, v2);
       if constexpr (!REMAP) continue;
       affine_.matrix(mp, B, as, mC);
+      AffineTransfer<D>::template momenta<NPP>(as, npp, mv, mC, am);
+#pragma GCC unroll 16
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
-        affine_.add_momentum(st.w[kp], as, k, mv, mC, remap + size_t(st.node[kp]) * D);
+        double* r = remap + size_t(st.node[kp]) * D;
+        for (int d = 0; d < D; ++d) r[d] += st.w[kp] * am.at(k, d);
       }
     }
     sc.max_v2 = max_v2;

@@ -476,11 +476,17 @@ class TwoPhaseDoublePoint : public Scheme<D> {
 
   // ------------------------------------------------------------------ particle to grid
   /// Solid points: mass, momentum, force (effective stress, weight, loads), drag, solid volume.
-  /// APIC: point i's stencil geometry at its position and m B_p D_p^-1 (mass m).
-  void affine_matrix(const Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
-                     double m, AffineStencil& as, double (&mC)[D][D]) const {
+  /// APIC: point i's stencil geometry at its position and its affine momenta per unit weight
+  /// of every stencil entry, m v_p + m B_p D_p^-1 (x_I - x_p) (mass m, momentum mv).
+  template <int NPP>
+  using Momenta = typename AffineTransfer<D>::template Momenta<NPP>;
+  template <int NPP>
+  void affine_momenta(const Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
+                      double m, const double (&mv)[D], AffineStencil& as, Momenta<NPP>& am) const {
+    double mC[D][D];
     affine_.stencil(P, st, p, i, npp, as);
     affine_.matrix(P, B_, i, m, as, mC);
+    AffineTransfer<D>::template momenta<NPP>(as, npp, mv, mC, am);
   }
 
   template <int NPP>
@@ -496,16 +502,17 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     drag_coefficients(P, st, b, count, npp, sc.Q.data());
     double* g = node_.data();
     AffineStencil as;
+    Momenta<NPP> am;  // APIC: the momenta per unit weight
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      double mv[D], body[D], sv[D][D], mC[D][D] = {};
+      double mv[D], body[D], sv[D][D];
       for (int d = 0; d < D; ++d) {
         mv[d] = ms[p] * P.col(P.velocity, d)[i];
         const double fe = sim.external_force >= 0 ? P.col(sim.external_force, d)[i] : 0.0;
         body[d] = ms[p] * sim.gravity[size_t(d)] + fe;
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * P.col(P.stress, voigt_index(d, j))[i];
       }
-      if (affine_on_) affine_matrix(P, st, p, i, npp, ms[p], as, mC);
+      if (affine_on_) affine_momenta<NPP>(P, st, p, i, npp, ms[p], mv, as, am);
       const double vq = V[p] * sc.Q[size_t(p)], vs = (1 - n[p]) * V[p];
       cell_solid_[particle_cell(sim.grid, P, i)] += vs;  // in the stencil: race-free
       for (int k = 0; k < npp; ++k) {
@@ -515,9 +522,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         r[kMs] += w * ms[p];
         r[kQ] += w * vq;
         r[kN] += w * vs;
-        if (affine_on_) AffineTransfer<D>::add_momentum(w, as, k, mv, mC, r + kV);
         for (int d = 0; d < D; ++d) {
-          if (!affine_on_) r[kV + d] += w * mv[d];
+          r[kV + d] += w * (affine_on_ ? am.at(k, d) : mv[d]);  // APIC: the affine momentum
           double f = w * body[d];
           for (int j = 0; j < D; ++j)
             f -= sv[d][j] * st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
@@ -565,26 +571,26 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     double* n = P.col(n_) + b;
     double* g = node_.data();
     AffineStencil as;
+    Momenta<NPP> am;  // APIC: the momenta per unit weight
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       n[p] = liquid_porosity(liquid_cell_[i]);  // the solid set is scattered first
       const double Vmix = V[p] / n[p];
-      double mv[D], body[D], sv[D][D], mC[D][D] = {};
+      double mv[D], body[D], sv[D][D];
       for (int d = 0; d < D; ++d) {
         mv[d] = mw[p] * P.col(P.velocity, d)[i];
         const double fe = sim.external_force >= 0 ? P.col(sim.external_force, d)[i] : 0.0;
         body[d] = mw[p] * sim.gravity[size_t(d)] + fe;
         for (int j = 0; j < D; ++j) sv[d][j] = Vmix * P.col(P.stress, voigt_index(d, j))[i];
       }
-      if (affine_on_) affine_matrix(P, st, p, i, npp, mw[p], as, mC);
+      if (affine_on_) affine_momenta<NPP>(P, st, p, i, npp, mw[p], mv, as, am);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
         double* r = g + size_t(st.node[kp]) * S;
         r[kMw] += w * mw[p];
-        if (affine_on_) AffineTransfer<D>::add_momentum(w, as, k, mv, mC, r + kW);
         for (int d = 0; d < D; ++d) {
-          if (!affine_on_) r[kW + d] += w * mv[d];
+          r[kW + d] += w * (affine_on_ ? am.at(k, d) : mv[d]);  // APIC: the affine momentum
           r[kFw + d] += w * body[d];
           double f = 0;
           for (int j = 0; j < D; ++j)
@@ -703,13 +709,13 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     const double* m = P.col(P.mass) + b;
     double* move = move_[phase].data() + b * D;
     const double flip = flip_;
+    const bool affine = affine_on_;  // a local: the compiler sees it constant over the block
     double max_v2 = sc.max_v2;
     AffineStencil as;
+    Momenta<NPP> am;  // APIC: the momenta per unit weight
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      double vg[D] = {}, ag[D] = {}, B[D][D] = {};
-      // B_p = sum_I N_Ip v_I (x_I - x_p)^T at x^n (framework/affine_transfer.hpp)
-      if (affine_on_) affine_.stencil(P, st, p, i, npp, as);
+      double vg[D] = {}, ag[D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const double w = st.w[kp];
@@ -718,26 +724,35 @@ class TwoPhaseDoublePoint : public Scheme<D> {
           vg[d] += w * r[kv + d];
           ag[d] += w * r[ka + d];
         }
-        if (affine_on_) affine_.add_moment(st, k, p, r + kv, as, B);
       }
       double v2 = 0, vp[D];
       for (int d = 0; d < D; ++d) {
         double& v = P.col(P.velocity, d)[i];
-        v = vp[d] = affine_on_ ? vg[d] : flip_pic(flip, v, dt, ag[d], vg[d]);
+        v = vp[d] = affine ? vg[d] : flip_pic(flip, v, dt, ag[d], vg[d]);
         move[size_t(p) * D + size_t(d)] = dt * vg[d];
         v2 += vp[d] * vp[d];
       }
       max_v2 = std::max(max_v2, v2);
-      if (affine_on_) {  // the re-map carries the affine momentum too
-        affine_.store(P, B_, i, B);
-        double mv[D], mC[D][D];
-        for (int d = 0; d < D; ++d) mv[d] = m[p] * vp[d];
-        affine_.matrix(m[p], B, as, mC);
+      if (affine) {  // the re-map carries the affine momentum too
+        // B_p = sum_I N_Ip v_I (x_I - x_p)^T at x^n (framework/affine_transfer.hpp), a second
+        // pass over the (cached) stencil's nodes
+        typename AffineTransfer<D>::template MomentSum<NPP> sum;
+        sum.clear();
+        affine_.stencil(P, st, p, i, npp, as);
         for (int k = 0; k < npp; ++k) {
           const size_t kp = size_t(k) * kBlock + size_t(p);
-          AffineTransfer<D>::add_momentum(
-              st.w[kp], as, k, mv, mC,
-              remap_.data() + size_t(st.node[kp]) * 2 * D + size_t(phase * D));
+          affine_.add_moment(sum, st, k, p, st.w[kp], g + size_t(st.node[kp]) * S + kv, as);
+        }
+        double B[D][D], mv[D], mC[D][D];
+        affine_.moment(sum, as, B);
+        affine_.store(P, B_, i, B);
+        for (int d = 0; d < D; ++d) mv[d] = m[p] * vp[d];
+        affine_.matrix(m[p], B, as, mC);
+        AffineTransfer<D>::template momenta<NPP>(as, npp, mv, mC, am);
+        for (int k = 0; k < npp; ++k) {
+          const size_t kp = size_t(k) * kBlock + size_t(p);
+          double* r = remap_.data() + size_t(st.node[kp]) * 2 * D + size_t(phase * D);
+          for (int d = 0; d < D; ++d) r[d] += st.w[kp] * am.at(k, d);
         }
         continue;
       }

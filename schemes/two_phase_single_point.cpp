@@ -326,17 +326,22 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     }
   }
 
-  /// APIC: m B D^-1 of both phases of particle i (solid mass ms, water mw) and their momenta
-  /// m v, at the stencil geometry `as`.
-  void affine_momenta(const Particles<D>& P, size_t i, double ms, double mw,
-                      const AffineStencil& as, double (&msv)[D], double (&mwv)[D],
-                      double (&mCs)[D][D], double (&mCw)[D][D]) const {
+  /// APIC: the affine momenta per unit weight of both phases of particle i (solid mass ms,
+  /// water mass mw) for each of its npp stencil entries, at the stencil geometry `as`.
+  template <int NPP>
+  using Momenta = typename AffineTransfer<D>::template Momenta<NPP>;
+  template <int NPP>
+  void affine_momenta(const Particles<D>& P, size_t i, int npp, double ms, double mw,
+                      const AffineStencil& as, Momenta<NPP>& am_s, Momenta<NPP>& am_w) const {
+    double msv[D], mwv[D], mCs[D][D], mCw[D][D];
     for (int d = 0; d < D; ++d) {
       msv[d] = ms * P.col(P.velocity, d)[i];
       mwv[d] = mw * P.col(w_, d)[i];
     }
     affine_.matrix(P, Bs_, i, ms, as, mCs);
     affine_.matrix(P, Bw_, i, mw, as, mCw);
+    AffineTransfer<D>::template momenta<NPP>(as, npp, msv, mCs, am_s);
+    AffineTransfer<D>::template momenta<NPP>(as, npp, mwv, mCw, am_w);
   }
 
   template <int NPP>
@@ -364,14 +369,14 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     drag_->coefficient(size_t(count), n, drag_->speed_dependent() ? speed : nullptr, sc.Q.data());
     double* g = node_.data();
     AffineStencil as;
+    Momenta<NPP> am_s, am_w;  // APIC: the phases' momenta per unit weight
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       const double mw = n[p] * rho_w_ * V[p];
-      double vs[D], vw[D], body[D], sv[D][D], msv[D] = {}, mwv[D] = {}, mCs[D][D] = {},
-                                              mCw[D][D] = {};
+      double vs[D], vw[D], body[D], sv[D][D];
       if (affine_on_) {
         affine_.stencil(P, st, p, i, npp, as);
-        affine_momenta(P, i, ms[p], mw, as, msv, mwv, mCs, mCw);
+        affine_momenta<NPP>(P, i, npp, ms[p], mw, as, am_s, am_w);
       }
       for (int d = 0; d < D; ++d) {
         vs[d] = P.col(P.velocity, d)[i];
@@ -394,8 +399,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         for (int j = 0; j < D; ++j)
           gr[j] = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
         if (affine_on_) {  // the phases' affine momenta
-          AffineTransfer<D>::add_momentum(w, as, k, msv, mCs, r + kV);
-          AffineTransfer<D>::add_momentum(w, as, k, mwv, mCw, r + kW);
+          for (int d = 0; d < D; ++d) {
+            r[kV + d] += w * am_s.at(k, d);
+            r[kW + d] += w * am_w.at(k, d);
+          }
         }
         for (int d = 0; d < D; ++d) {
           if (!affine_on_) {
@@ -514,20 +521,23 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     const int npp = NPP ? NPP : st.npp;
     double max_v2 = sc.max_v2;
     AffineStencil as;
+    Momenta<NPP> am_s, am_w;  // APIC: the phases' momenta per unit weight
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      max_v2 = std::max(max_v2, velocity_update<false>(sim, P, st, p, i, npp, dt, &move_[i * D],
+      max_v2 =
+          std::max(max_v2, velocity_update<NPP, false>(sim, P, st, p, i, npp, dt, &move_[i * D],
                                                        affine_on_ ? &as : nullptr));
       const double ms = P.col(P.mass)[i], mw = P.col(n_)[i] * rho_w_ * P.col(P.volume)[i];
-      double msv[D] = {}, mwv[D] = {}, mCs[D][D] = {}, mCw[D][D] = {};
       // The re-map carries the affine momenta, with D_p at x^n (as the scatter).
-      if (affine_on_) affine_momenta(P, i, ms, mw, as, msv, mwv, mCs, mCw);
+      if (affine_on_) affine_momenta<NPP>(P, i, npp, ms, mw, as, am_s, am_w);
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         double* r = remap_.data() + size_t(st.node[kp]) * 2 * D;
         if (affine_on_) {
-          AffineTransfer<D>::add_momentum(st.w[kp], as, k, msv, mCs, r);
-          AffineTransfer<D>::add_momentum(st.w[kp], as, k, mwv, mCw, r + D);
+          for (int d = 0; d < D; ++d) {
+            r[d] += st.w[kp] * am_s.at(k, d);
+            r[D + d] += st.w[kp] * am_w.at(k, d);
+          }
         } else {
           for (int d = 0; d < D; ++d) {
             r[d] += st.w[kp] * ms * P.col(P.velocity, d)[i];
@@ -561,12 +571,11 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// faces), else stored in `move` (D values) for the gradient pass; returns |v|^2. With APIC
   /// (`as` given): v and w from the grid velocities and both B_p, taken at x^n before the move
   /// (framework/affine_transfer.hpp), `as` left holding the stencil geometry there.
-  template <bool MOVE>
+  template <int NPP, bool MOVE>
   double velocity_update(const Simulation<D>& sim, Particles<D>& P, const StencilBlock<D>& st,
                          int p, size_t i, int npp, double dt, double* move = nullptr,
                          AffineStencil* as = nullptr) {
-    double vn[D] = {}, wn[D] = {}, acc_s[D] = {}, acc_w[D] = {}, Bs[D][D] = {}, Bw[D][D] = {};
-    if (as) affine_.stencil(P, st, p, i, npp, *as);
+    double vn[D] = {}, wn[D] = {}, acc_s[D] = {}, acc_w[D] = {};
     for (int k = 0; k < npp; ++k) {
       const size_t kp = size_t(k) * kBlock + size_t(p);
       const double w = st.w[kp];
@@ -577,12 +586,21 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         acc_s[d] += w * r[kF + d];
         acc_w[d] += w * r[kFw + d];
       }
-      if (as) {
-        affine_.add_moment(st, k, p, r + kV, *as, Bs);
-        affine_.add_moment(st, k, p, r + kW, *as, Bw);
-      }
     }
-    if (as) {
+    if (as) {  // both phases' B_p, a second pass over the (cached) stencil's nodes
+      typename AffineTransfer<D>::template MomentSum<NPP> sum_s, sum_w;
+      sum_s.clear();
+      sum_w.clear();
+      affine_.stencil(P, st, p, i, npp, *as);
+      for (int k = 0; k < npp; ++k) {
+        const size_t kp = size_t(k) * kBlock + size_t(p);
+        const double* r = node_.data() + size_t(st.node[kp]) * S;
+        affine_.add_moment(sum_s, st, k, p, st.w[kp], r + kV, *as);
+        affine_.add_moment(sum_w, st, k, p, st.w[kp], r + kW, *as);
+      }
+      double Bs[D][D], Bw[D][D];
+      affine_.moment(sum_s, *as, Bs);
+      affine_.moment(sum_w, *as, Bw);
       affine_.store(P, Bs_, i, Bs);
       affine_.store(P, Bw_, i, Bw);
     }
@@ -623,8 +641,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       // USL: the velocity update happens here; MUSL did it in the re-map pass.
       // (the stencil was evaluated at x^n above, so moving here does not change it).
       if constexpr (!REMAPPED)
-        max_v2 = std::max(max_v2, velocity_update<true>(sim, P, st, p, i, npp, dt, nullptr,
-                                                        affine_on_ ? &as : nullptr));
+        max_v2 = std::max(max_v2, velocity_update<NPP, true>(sim, P, st, p, i, npp, dt, nullptr,
+                                                             affine_on_ ? &as : nullptr));
       double ls[D][D] = {}, lw[D][D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);

@@ -27,8 +27,7 @@ class Linear : public ShapeFunction<D> {
     out.count = count;
     // Per-axis weights first (vectorises across particles), then the 2^D tensor products,
     // node-major so that each inner loop runs over contiguous particles.
-    alignas(64) double n[D][2][kBlock];   // the two nodes' axis weights
-    alignas(64) double dx[D][2][kBlock];  // their x_I - x_p, for the affine transfers
+    alignas(64) double n[D][2][kBlock];  // the two nodes' axis weights
     alignas(64) int32_t base[kBlock];
     const bool affine = out.affine != StencilBlock<D>::kNone;
     for (int p = 0; p < count; ++p) base[p] = 0;
@@ -37,6 +36,8 @@ class Linear : public ShapeFunction<D> {
       const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
       const int last = g.cells[d] - 1;
       const int32_t stride = int32_t(g.node_stride[d]), lo = g.node_lo[size_t(d)];
+      double* __restrict dx0 = affine ? axis_offsets(out.dx, 2, d, 0) : nullptr;
+      double* __restrict dx1 = affine ? axis_offsets(out.dx, 2, d, 1) : nullptr;
       for (int p = 0; p < count; ++p) {
         const double xi = (x[p] - o) * ih;
         int c = int(xi);
@@ -46,12 +47,12 @@ class Linear : public ShapeFunction<D> {
         n[d][1][p] = r;
         base[p] += (c - lo) * stride;  // the stored box's index (Grid)
         if (affine) {  // the offsets, node coordinates as Grid::node_coord forms them
-          dx[d][0][p] = (o + double(c) * g.cell[size_t(d)]) - x[p];
-          dx[d][1][p] = (o + double(c + 1) * g.cell[size_t(d)]) - x[p];
+          dx0[p] = (o + double(c) * g.cell[size_t(d)]) - x[p];
+          dx1[p] = (o + double(c + 1) * g.cell[size_t(d)]) - x[p];
         }
       }
     }
-    axis_affine_product<D, 2>(count, n, dx, out);
+    axis_affine_product<D, 2>(count, n, out);
     for (int k = 0; k < K; ++k) {
       int32_t offset = 0;
       for (int d = 0; d < D; ++d) offset += (k >> d) & 1 ? int32_t(g.node_stride[d]) : 0;

@@ -111,7 +111,7 @@ AffineGeometryErrors affine_geometry_errors(loam::Simulation<D>& sim) {
           const size_t kdp = (size_t(k) * D + size_t(d)) * loam::kBlock + size_t(p);
           same = same && st.grad[kdp] == plain.grad[kdp];
           dx[d] = g.node_coord(size_t(st.node[kp]), d) - P.col(P.position, d)[b + size_t(p)];
-          if (st.dx[kdp] != dx[d]) e.offsets += 1;
+          if (st.offset(k, d, p) != dx[d]) e.offsets += 1;
         }
         if (!same) e.changed += 1;
         for (int d = 0; d < D; ++d)

@@ -175,7 +175,8 @@ void check_box_evaluation(const std::string& shape, const std::array<int, D>& di
           for (int j = 0; j < D; ++j) {
             const size_t kj = (size_t(k) * D + size_t(j)) * loam::kBlock + size_t(p);
             same = same && whole.grad[kj] == box.grad[kj];
-            if (whole.has_affine) same = same && box.has_affine && whole.dx[kj] == box.dx[kj];
+            if (whole.has_affine)
+              same = same && box.has_affine && whole.offset(k, j, p) == box.offset(k, j, p);
           }
           if (whole.has_affine)
             for (int j = 0; j < D; ++j)
