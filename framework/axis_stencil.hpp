@@ -24,7 +24,7 @@ void axis_affine_product(int count, const double (&w)[D][M][kBlock], StencilBloc
   out.axis_nodes = M;
   if (out.affine != StencilBlock<D>::kInertia) return;
   for (int d = 0; d < D; ++d) {
-    const double* dx = out.dx.data() + size_t(d) * M * kBlock;
+    const double* dx = out.dx.data() + StencilBlock<D>::axis_offset_index(M, d, 0);
     double* __restrict inv = out.inertia_inv.data() + size_t(d) * kBlock;
     for (int p = 0; p < count; ++p) {
       double m2 = 0;
@@ -34,11 +34,13 @@ void axis_affine_product(int count, const double (&w)[D][M][kBlock], StencilBloc
   }
 }
 
-/// x_I - x_p of axis node j along axis d into the stencil block (StencilBlock::dx), with the
-/// node coordinate as Grid::node_coord forms it (origin + i h, i the global index), so the
-/// offsets are the same bits as from the node coordinates, on a stored box of nodes too.
-LOAM_FORCE_INLINE double* axis_offsets(std::vector<double>& dx, int M, int d, int j) {
-  return dx.data() + (size_t(d) * size_t(M) + size_t(j)) * kBlock;
+/// Where a shape function writes x_I - x_p of axis node j along axis d in the stencil block
+/// (StencilBlock::dx), with the node coordinate as Grid::node_coord forms it (origin + i h, i the
+/// global index), so the offsets are the same bits as from the node coordinates, on a stored box
+/// of nodes too.
+template <int D>
+LOAM_FORCE_INLINE double* axis_offsets(StencilBlock<D>& out, int M, int d, int j) {
+  return out.dx.data() + StencilBlock<D>::axis_offset_index(M, d, j);
 }
 
 /// Per-axis weights, gradients and node offsets (node coordinate times stride) of M nodes for a
@@ -62,7 +64,7 @@ struct AxisStencil {
     if (out.affine == StencilBlock<D>::kNone) return;
     const double o = g.origin[size_t(d)], h = g.cell[size_t(d)];
     for (int j = 0; j < M; ++j) {
-      double* __restrict dx = axis_offsets(out.dx, M, d, j);
+      double* __restrict dx = axis_offsets(out, M, d, j);
       for (int p = 0; p < count; ++p) dx[p] = (o + double(index[d][j][p]) * h) - x[p];
     }
   }

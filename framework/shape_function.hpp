@@ -43,11 +43,18 @@ struct StencilBlock {
   std::vector<double> dx;           // [(d*M + j)*kBlock + p]: x_I - x_p of axis node j along d
   std::vector<double> inertia_inv;  // [d*kBlock + p]: 1 / D_p(d, d) (D_p diagonal)
 
+  /// Stencil entry k's node along axis d: (k / M^d) % M, for M nodes per axis.
+  static constexpr int axis_node(int k, int d, int M) {
+    for (int e = 0; e < d; ++e) k /= M;
+    return k % M;
+  }
+  /// Where the offsets of axis node j along axis d start in dx (then one per particle).
+  static constexpr size_t axis_offset_index(int M, int d, int j) {
+    return (size_t(d) * size_t(M) + size_t(j)) * kBlock;
+  }
   /// x_I - x_p along axis d of stencil entry k of particle p (has_affine).
   double offset(int k, int d, int p) const {
-    int j = k;
-    for (int e = 0; e < d; ++e) j /= axis_nodes;
-    return dx[(size_t(d) * size_t(axis_nodes) + size_t(j % axis_nodes)) * kBlock + size_t(p)];
+    return dx[axis_offset_index(axis_nodes, d, axis_node(k, d, axis_nodes)) + size_t(p)];
   }
 
   void allocate(int nodes_per_particle) {

@@ -709,7 +709,6 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     const double* m = P.col(P.mass) + b;
     double* move = move_[phase].data() + b * D;
     const double flip = flip_;
-    const bool affine = affine_on_;  // a local: the compiler sees it constant over the block
     double max_v2 = sc.max_v2;
     AffineStencil as;
     Momenta<NPP> am;  // APIC: the momenta per unit weight
@@ -728,12 +727,12 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       double v2 = 0, vp[D];
       for (int d = 0; d < D; ++d) {
         double& v = P.col(P.velocity, d)[i];
-        v = vp[d] = affine ? vg[d] : flip_pic(flip, v, dt, ag[d], vg[d]);
+        v = vp[d] = affine_on_ ? vg[d] : flip_pic(flip, v, dt, ag[d], vg[d]);
         move[size_t(p) * D + size_t(d)] = dt * vg[d];
         v2 += vp[d] * vp[d];
       }
       max_v2 = std::max(max_v2, v2);
-      if (affine) {  // the re-map carries the affine momentum too
+      if (affine_on_) {  // the re-map carries the affine momentum too
         // B_p = sum_I N_Ip v_I (x_I - x_p)^T at x^n (framework/affine_transfer.hpp), a second
         // pass over the (cached) stencil's nodes
         typename AffineTransfer<D>::template MomentSum<NPP> sum;

@@ -36,8 +36,8 @@ class Linear : public ShapeFunction<D> {
       const double o = g.origin[size_t(d)], ih = g.inv_cell[size_t(d)];
       const int last = g.cells[d] - 1;
       const int32_t stride = int32_t(g.node_stride[d]), lo = g.node_lo[size_t(d)];
-      double* __restrict dx0 = affine ? axis_offsets(out.dx, 2, d, 0) : nullptr;
-      double* __restrict dx1 = affine ? axis_offsets(out.dx, 2, d, 1) : nullptr;
+      double* __restrict dx0 = affine ? axis_offsets(out, 2, d, 0) : nullptr;
+      double* __restrict dx1 = affine ? axis_offsets(out, 2, d, 1) : nullptr;
       for (int p = 0; p < count; ++p) {
         const double xi = (x[p] - o) * ih;
         int c = int(xi);

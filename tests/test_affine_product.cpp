@@ -28,7 +28,7 @@ void check_product_form(std::mt19937& rng, double& momenta_differing, double& mo
   for (int d = 0; d < D; ++d)  // axis offsets in the block's layout, h = 0.1
     for (int j = 0; j < M; ++j)
       for (int p = 0; p < kB; ++p)
-        st.dx[(size_t(d) * M + size_t(j)) * kB + size_t(p)] =
+        st.dx[loam::StencilBlock<D>::axis_offset_index(M, d, j) + size_t(p)] =
             0.1 * (j - 0.5 * (M - 1) + 0.4 * u(rng));
   const AT transfer;  // APIC's B_p form
   for (int p = 0; p < kB; ++p) {
