@@ -54,6 +54,7 @@
 // beyond the affine one to APIC; it is not built here.
 #include <Eigen/Dense>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "force_inline.hpp"
@@ -61,6 +62,25 @@
 #include "shape_function.hpp"
 
 namespace loam {
+
+/// How a pass's loop runs the per-particle affine algebra, compiled per block
+/// (AffineTransfer::with_form): kOff, no affine transfer; kAny, the form decided per particle
+/// (CPDI, node coordinates, TPIC, linear tents); kProduct, APIC's B_p on a tensor-product stencil
+/// of axis_nodes_of(NPP) nodes per axis, the product form with no check per stencil entry.
+enum class AffineForm { kOff, kAny, kProduct };
+
+/// A pass's loop over a particle's stencil entries, entry(k) for k < npp: unrolled with an
+/// affine form (the product form's axis indices of entry k are then constants; a plain loop
+/// sharing the pragma made FLIP's P2G 4 % slower), plain without one.
+template <AffineForm FORM, class Entry>
+LOAM_FORCE_INLINE void for_each_entry(int npp, Entry&& entry) {
+  if constexpr (FORM != AffineForm::kOff) {
+#pragma GCC unroll 16
+    for (int k = 0; k < npp; ++k) entry(k);
+  } else {
+    for (int k = 0; k < npp; ++k) entry(k);
+  }
+}
 
 template <int D>
 class AffineTransfer {
@@ -107,24 +127,45 @@ class AffineTransfer {
   /// over the entries at axis node i along e, so an entry costs D^2 additions instead of D^2
   /// products and additions.
   /// Cleared per particle (clear) by the pass that sums it, so that a FLIP pass declaring
-  /// one pays nothing.
-  template <int NPP>
+  /// one pays nothing. F = kProduct: the product form only (with_form).
+  template <int NPP, AffineForm F = AffineForm::kAny>
   struct MomentSum {
     static constexpr int M = axis_nodes_of(NPP);
+    static constexpr bool kProduct = F == AffineForm::kProduct;
+    static_assert(!kProduct || M > 0, "the product form needs a tensor-product stencil");
     double axis[D][M > 0 ? M : 1][D];  // S_e(i): the product form
     double B[D][D];                    // per entry: CPDI, node coordinates, TPIC
     LOAM_FORCE_INLINE void clear() {
       for (int e = 0; e < D; ++e)
         for (int i = 0; i < (M > 0 ? M : 1); ++i)
           for (int d = 0; d < D; ++d) axis[e][i][d] = 0.0;
-      for (int d = 0; d < D; ++d)
-        for (int j = 0; j < D; ++j) B[d][j] = 0.0;
+      if constexpr (!kProduct)
+        for (int d = 0; d < D; ++d)
+          for (int j = 0; j < D; ++j) B[d][j] = 0.0;
     }
   };
 
   /// The transfer's name in a scheme's `transfer` key: apic or tpic.
   static bool is_affine(const std::string& transfer) {
     return transfer == "apic" || transfer == "tpic";
+  }
+
+  /// Whether a block's stencil (after evaluate) takes the product form of APIC's B_p: a
+  /// tensor-product stencil of axis_nodes_of(NPP) nodes per axis with its offsets, B_p not C_p.
+  template <int NPP>
+  bool product_form(const StencilBlock<D>& st) const {
+    constexpr int M = axis_nodes_of(NPP);
+    return M > 0 && st.has_affine && st.axis_nodes == M && !gradient_form_;
+  }
+  /// Calls fn(std::integral_constant<AffineForm, F>) with the block's form (product_form:
+  /// kProduct, else kAny), so that a scheme's APIC loop is compiled without the per-entry checks
+  /// of the general form.
+  template <int NPP, class Fn>
+  LOAM_FORCE_INLINE void with_form(const StencilBlock<D>& st, Fn&& fn) const {
+    if constexpr (axis_nodes_of(NPP) > 0)
+      if (product_form<NPP>(st))
+        return fn(std::integral_constant<AffineForm, AffineForm::kProduct>{});
+    fn(std::integral_constant<AffineForm, AffineForm::kAny>{});
   }
 
   /// Node coordinates (x_I - x_p without divisions) and the form: B_p (APIC), or C_p for TPIC
@@ -156,6 +197,18 @@ class AffineTransfer {
     if (on) st.affine = gradient_form_ ? StencilBlock<D>::kOffsets : StencilBlock<D>::kInertia;
     sim.shape->evaluate(sim.grid, P, begin, count, st);
     st.affine = StencilBlock<D>::kNone;  // the other passes' evaluations need none
+  }
+
+  /// A pass's block: evaluate its stencil (with the affine geometry when `on`) and call
+  /// kernel(std::integral_constant<AffineForm, F>) with its form: kOff when not `on`, else as
+  /// with_form. The schemes compile their loops per form this way.
+  template <int NPP, class Kernel>
+  LOAM_FORCE_INLINE void evaluate_with_form(const Simulation<D>& sim, const Particles<D>& P,
+                                            size_t begin, int count, StencilBlock<D>& st, bool on,
+                                            Kernel&& kernel) const {
+    evaluate(sim, P, begin, count, st, on);
+    if (!on) return kernel(std::integral_constant<AffineForm, AffineForm::kOff>{});
+    with_form<NPP>(st, kernel);
   }
 
   /// x_I - x_p of every stencil entry of particle p of the block (index i in P) and D_p^-1:
@@ -201,23 +254,31 @@ class AffineTransfer {
       for (int j = 0; j < D; ++j) a.inertia_inv[d][j] = inv(d, j);
   }
 
-  /// Particle i's B_p (or C_p) from its field `field` (D x D, row-major), and back.
-  LOAM_FORCE_INLINE static void load(const Particles<D>& P, int field, size_t i,
-                                     double (&B)[D][D]) {
-    for (int d = 0; d < D; ++d)
-      for (int j = 0; j < D; ++j) B[d][j] = P.col(field, d * D + j)[i];
-  }
-  LOAM_FORCE_INLINE static void store(Particles<D>& P, int field, size_t i,
-                                      const double (&B)[D][D]) {
-    for (int d = 0; d < D; ++d)
-      for (int j = 0; j < D; ++j) P.col(field, d * D + j)[i] = B[d][j];
+  /// The D x D columns (row-major) of the particle field holding B_p (or C_p), looked up once
+  /// per block: looked up per particle through Particles::col, a chain of dependent loads held
+  /// up the P2G and G2P loops (issue 17's profile).
+  struct Columns {
+    double* c[D * D] = {};
+    LOAM_FORCE_INLINE void load(size_t i, double (&B)[D][D]) const {
+      for (int d = 0; d < D; ++d)
+        for (int j = 0; j < D; ++j) B[d][j] = c[d * D + j][i];
+    }
+    LOAM_FORCE_INLINE void store(size_t i, const double (&B)[D][D]) const {
+      for (int d = 0; d < D; ++d)
+        for (int j = 0; j < D; ++j) c[d * D + j][i] = B[d][j];
+    }
+  };
+  static Columns columns(Particles<D>& P, int field) {
+    Columns c;
+    for (int k = 0; k < D * D; ++k) c.c[k] = P.col(field, k);
+    return c;
   }
 
-  /// mC = m B D^-1 of particle i from its field `field`, at the stencil geometry `a`.
-  LOAM_FORCE_INLINE void matrix(const Particles<D>& P, int field, size_t i, double m,
-                                const Stencil& a, double (&mC)[D][D]) const {
+  /// mC = m B D^-1 of particle i from its field's columns, at the stencil geometry `a`.
+  LOAM_FORCE_INLINE void matrix(const Columns& field, size_t i, double m, const Stencil& a,
+                                double (&mC)[D][D]) const {
     double B[D][D];
-    load(P, field, i, B);
+    field.load(i, B);
     matrix(m, B, a, mC);
   }
 
@@ -248,15 +309,18 @@ class AffineTransfer {
   /// t_0(i) = m v_p + mC_:0 dx_0(i) and t_e(i) = mC_:e dx_e(i): D (D - 1) additions per entry,
   /// done where the scatter reads it (unrolled, i_e(k) are constants); the same bits as the
   /// per-entry sum m v_p + mC_:0 dx_0 + mC_:1 dx_1 + ...
-  template <int NPP>
+  /// F = kProduct: the product form only (with_form).
+  template <int NPP, AffineForm F = AffineForm::kAny>
   struct Momenta {
     static constexpr int M = axis_nodes_of(NPP);
-    bool product = false;
+    static constexpr bool kProduct = F == AffineForm::kProduct;
+    static_assert(!kProduct || M > 0, "the product form needs a tensor-product stencil");
+    bool product = kProduct;
     double t[D][M > 0 ? M : 1][D] = {};  // the product form: t_e(i) (declare once per block)
-    double a[NPP > 0 ? NPP : kMaxEntries][D] = {};  // per entry (CPDI, node coordinates)
+    double a[kProduct ? 1 : NPP > 0 ? NPP : kMaxEntries][D] = {};  // per entry (CPDI, nodes)
     LOAM_FORCE_INLINE double at(int k, int d) const {
       if constexpr (M > 0) {
-        if (product) {
+        if (kProduct || product) {
           double v = t[0][k % M][d];
           for (int e = 1, r = k / M; e < D; ++e, r /= M) v += t[e][r % M][d];
           return v;
@@ -265,13 +329,13 @@ class AffineTransfer {
       return a[k][d];
     }
   };
-  template <int NPP>
+  template <int NPP, AffineForm F>
   LOAM_FORCE_INLINE static void momenta(const Stencil& s, int npp, const double (&mv)[D],
-                                        const double (&mC)[D][D], Momenta<NPP>& out) {
-    constexpr int M = Momenta<NPP>::M;
+                                        const double (&mC)[D][D], Momenta<NPP, F>& out) {
+    constexpr int M = Momenta<NPP, F>::M;
     if constexpr (M > 0) {
-      out.product = s.m == M;
-      if (out.product) {
+      if constexpr (!Momenta<NPP, F>::kProduct) out.product = s.m == M;
+      if (Momenta<NPP, F>::kProduct || out.product) {
         for (int e = 0; e < D; ++e)
           for (int i = 0; i < M; ++i) {
             const double x = s.template axis<M>(e, i);
@@ -281,20 +345,27 @@ class AffineTransfer {
         return;
       }
     }
-    for (int k = 0; k < npp; ++k)
-      for (int d = 0; d < D; ++d) {
-        double v = mv[d];
-        for (int j = 0; j < D; ++j) v += mC[d][j] * s.dx(k, j);
-        out.a[k][d] = v;
-      }
+    if constexpr (!Momenta<NPP, F>::kProduct)
+      for (int k = 0; k < npp; ++k)
+        for (int d = 0; d < D; ++d) {
+          double v = mv[d];
+          for (int j = 0; j < D; ++j) v += mC[d][j] * s.dx(k, j);
+          out.a[k][d] = v;
+        }
   }
 
   /// G2P of stencil entry k of block particle p, weight w, node velocity v_I: APIC's
   /// B += w v_I (x_I - x_p)^T (in the product form: MomentSum), TPIC's C += v_I grad N^T
   /// (nothing with linear tents, whose C_p the USF gradient pass stores).
-  template <int NPP>
-  LOAM_FORCE_INLINE void add_moment(MomentSum<NPP>& sum, const StencilBlock<D>& st, int k, int p,
+  template <int NPP, AffineForm F>
+  LOAM_FORCE_INLINE void add_moment(MomentSum<NPP, F>& sum, const StencilBlock<D>& st, int k, int p,
                                     double w, const double* vI, const Stencil& s) const {
+    constexpr int M = MomentSum<NPP, F>::M;
+    if constexpr (MomentSum<NPP, F>::kProduct) {  // with_form checked the block
+      for (int e = 0, r = k; e < D; ++e, r /= M)
+        for (int d = 0; d < D; ++d) sum.axis[e][r % M][d] += w * vI[d];
+      return;
+    }
     if (usf_gradient_) return;
     if (gradient_form_) {
       for (int j = 0; j < D; ++j) {
@@ -303,7 +374,6 @@ class AffineTransfer {
       }
       return;
     }
-    constexpr int M = MomentSum<NPP>::M;
     if constexpr (M > 0) {
       if (s.m == M) {
         for (int e = 0, r = k; e < D; ++e, r /= M)
@@ -316,12 +386,12 @@ class AffineTransfer {
   }
 
   /// The particle's B_p (or C_p) from its sum over the entries.
-  template <int NPP>
-  LOAM_FORCE_INLINE void moment(const MomentSum<NPP>& sum, const Stencil& s,
+  template <int NPP, AffineForm F>
+  LOAM_FORCE_INLINE void moment(const MomentSum<NPP, F>& sum, const Stencil& s,
                                 double (&B)[D][D]) const {
-    constexpr int M = MomentSum<NPP>::M;
+    constexpr int M = MomentSum<NPP, F>::M;
     if constexpr (M > 0) {
-      if (!gradient_form_ && s.m == M) {
+      if (MomentSum<NPP, F>::kProduct || (!gradient_form_ && s.m == M)) {
         for (int d = 0; d < D; ++d)
           for (int e = 0; e < D; ++e) {
             double b = 0;

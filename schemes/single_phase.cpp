@@ -187,12 +187,13 @@ class SinglePhase : public Scheme<D> {
   /// (FORCE), all sets summed onto the one node record.
   template <int NPP, bool MOMENTUM, bool FORCE>
   void scatter_all(Simulation<D>& sim) {
-    // APIC's P2G is its own instantiation: the FLIP loop stays as it is without it.
+    // APIC's P2G is its own instantiation per form: the FLIP loop stays as it is without it.
     sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-      if (MOMENTUM && B_ >= 0)
-        scatter<NPP, MOMENTUM, FORCE, true>(sim, s, b, c, t);
-      else
-        scatter<NPP, MOMENTUM, FORCE, false>(sim, s, b, c, t);
+      affine_.template evaluate_with_form<NPP>(
+          sim, s.particles, b, c, scratch_[size_t(t)]->stencil, MOMENTUM && B_ >= 0,
+          [&](auto form) {
+            scatter<NPP, MOMENTUM, FORCE, decltype(form)::value>(sim, s, b, c, t);
+          });
     });
   }
   /// G2P velocity update (FLIP/PIC, or APIC's: update_velocity_apic); with REMAP the new
@@ -201,10 +202,12 @@ class SinglePhase : public Scheme<D> {
   template <int NPP, bool REMAP, bool MOVE>
   void update_velocities(Simulation<D>& sim, double dt) {
     auto f = [&](ParticleSet<D>& s, size_t b, int c, int t) {
-      if (affine_on_)
-        update_velocity_apic<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
-      else
-        update_velocity<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
+      if (!affine_on_) return update_velocity<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
+      affine_.template evaluate_with_form<NPP>(
+          sim, s.particles, b, c, scratch_[size_t(t)]->stencil, true, [&](auto form) {
+            if constexpr (decltype(form)::value != AffineForm::kOff)
+              update_velocity_apic<NPP, REMAP, MOVE, decltype(form)::value>(sim, s, dt, b, c, t);
+          });
     };
     if constexpr (REMAP)
       sim.scatter_blocks(f);
@@ -226,14 +229,14 @@ class SinglePhase : public Scheme<D> {
   }
 
   // ------------------------------------------------------------------ kernels
-  /// Particle-to-grid for one block: mass and momentum (MOMENTUM; AFFINE: APIC's), forces
-  /// (FORCE).
-  template <int NPP, bool MOMENTUM, bool FORCE, bool AFFINE>
+  /// Particle-to-grid for one evaluated block: mass and momentum (MOMENTUM; with an affine
+  /// FORM: APIC's), forces (FORCE).
+  template <int NPP, bool MOMENTUM, bool FORCE, AffineForm FORM>
   [[gnu::noinline]] void scatter(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count,
                                  int thread) {
+    constexpr bool AFFINE = FORM != AffineForm::kOff;
     Particles<D>& P = set.particles;
-    StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
-    affine_.evaluate(sim, P, b, count, st, AFFINE);
+    const StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
     const int npp = NPP ? NPP : st.npp;
     const double* m = P.col(P.mass) + b;
     const double* V = P.col(P.volume) + b;
@@ -247,7 +250,9 @@ class SinglePhase : public Scheme<D> {
     double* g = node_.data();
     const std::array<double, D> gravity = sim.gravity;
     typename AffineTransfer<D>::Stencil as;
-    typename AffineTransfer<D>::template Momenta<NPP> am;  // APIC: momenta per unit weight
+    typename AffineTransfer<D>::template Momenta<NPP, FORM> am;  // APIC: momenta per weight
+    typename AffineTransfer<D>::Columns Bp;
+    if constexpr (AFFINE) Bp = AffineTransfer<D>::columns(P, B_);
     for (int p = 0; p < count; ++p) {
       // Particle values in locals: the node stores below could alias the particle columns.
       const double mp = m[p];
@@ -260,7 +265,7 @@ class SinglePhase : public Scheme<D> {
       if constexpr (AFFINE) {  // APIC: m_p (N v_p + B_p D_p^-1 N (x_I - x_p)), see the header
         double mC[D][D];       // m_p B_p D_p^-1
         affine_.stencil(P, st, p, b + size_t(p), npp, as);
-        affine_.matrix(P, B_, b + size_t(p), mp, as, mC);
+        affine_.matrix(Bp, b + size_t(p), mp, as, mC);
         AffineTransfer<D>::template momenta<NPP>(as, npp, mv, mC, am);
       }
       // Stencil entry k's share: mass, the momentum per unit weight momentum(d), forces.
@@ -283,13 +288,13 @@ class SinglePhase : public Scheme<D> {
           }
         }
       };
-      if constexpr (AFFINE) {
-        // Unrolled: the product form's axis indices of entry k are then constants.
-#pragma GCC unroll 16
-        for (int k = 0; k < npp; ++k) add_entry(k, [&](int d) { return am.at(k, d); });
-      } else {
-        for (int k = 0; k < npp; ++k) add_entry(k, [&](int d) { return mv[d]; });
-      }
+      for_each_entry<FORM>(
+          npp, [&](int k) __attribute__((always_inline)) {
+            if constexpr (AFFINE)
+              add_entry(k, [&](int d) { return am.at(k, d); });
+            else
+              add_entry(k, [&](int d) { return mv[d]; });
+          });
     }
   }
 
@@ -399,58 +404,63 @@ class SinglePhase : public Scheme<D> {
     sc.max_v2 = max_v2;
   }
 
-  /// APIC grid-to-particle update of one block (the header's equations) from the updated grid
-  /// velocities; with REMAP the MUSL re-map of the new particle momenta, affine part included,
-  /// into vel_; with MOVE the move (after B_p is taken at the old position).
-  template <int NPP, bool REMAP, bool MOVE>
+  /// APIC grid-to-particle update of one evaluated block (the header's equations) from the
+  /// updated grid velocities; with REMAP the MUSL re-map of the new particle momenta, affine
+  /// part included, into vel_; with MOVE the move (after B_p is taken at the old position).
+  template <int NPP, bool REMAP, bool MOVE, AffineForm FORM>
   void update_velocity_apic(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
                             int thread) {
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
-    StencilBlock<D>& st = sc.stencil;
-    affine_.evaluate(sim, P, b, count, st);
+    const StencilBlock<D>& st = sc.stencil;
     const int npp = NPP ? NPP : st.npp;
     const double* g = node_.data();
     double* remap = vel_.data();
     const HeldFaces<D> walls = sim.held_faces;
     double max_v2 = sc.max_v2;
     typename AffineTransfer<D>::Stencil as;
-    typename AffineTransfer<D>::template Momenta<NPP> am;  // the re-map's momenta per weight
+    typename AffineTransfer<D>::template Momenta<NPP, FORM> am;  // the re-map's, per weight
+    const auto Bp = AffineTransfer<D>::columns(P, B_);
+    const double* m = P.col(P.mass);
+    std::array<double*, D> v{}, x{};
+    for (int d = 0; d < D; ++d) {
+      v[size_t(d)] = P.col(P.velocity, d);
+      x[size_t(d)] = P.col(P.position, d);
+    }
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       double vp[D] = {}, B[D][D];
-      typename AffineTransfer<D>::template MomentSum<NPP> sum;
+      typename AffineTransfer<D>::template MomentSum<NPP, FORM> sum;
       sum.clear();
       affine_.stencil(P, st, p, i, npp, as);
-#pragma GCC unroll 16
-      for (int k = 0; k < npp; ++k) {
-        const size_t kp = size_t(k) * kBlock + size_t(p);
-        const double w = st.w[kp];
-        const double* vI = g + size_t(st.node[kp]) * S + kMomentum;
-        for (int d = 0; d < D; ++d) vp[d] += w * vI[d];
-        affine_.add_moment(sum, st, k, p, w, vI, as);
-      }
+      for_each_entry<FORM>(
+          npp, [&](int k) __attribute__((always_inline)) {
+            const size_t kp = size_t(k) * kBlock + size_t(p);
+            const double w = st.w[kp];
+            const double* vI = g + size_t(st.node[kp]) * S + kMomentum;
+            for (int d = 0; d < D; ++d) vp[d] += w * vI[d];
+            affine_.add_moment(sum, st, k, p, w, vI, as);
+          });
       affine_.moment(sum, as, B);
       double v2 = 0, mv[D], mC[D][D];
-      const double mp = P.col(P.mass)[i];
-      if (!affine_.needs_usf()) affine_.store(P, B_, i, B);  // linear: the USF gradient pass
+      const double mp = m[i];
+      if (!affine_.needs_usf()) Bp.store(i, B);  // linear: the USF gradient pass
       for (int d = 0; d < D; ++d) {
-        P.col(P.velocity, d)[i] = vp[d];
+        v[size_t(d)][i] = vp[d];
         mv[d] = mp * vp[d];
         v2 += vp[d] * vp[d];
-        if constexpr (MOVE)
-          P.col(P.position, d)[i] = walls.moved(d, P.col(P.position, d)[i], dt * vp[d]);
+        if constexpr (MOVE) x[size_t(d)][i] = walls.moved(d, x[size_t(d)][i], dt * vp[d]);
       }
       max_v2 = std::max(max_v2, v2);
       if constexpr (!REMAP) continue;
       affine_.matrix(mp, B, as, mC);
       AffineTransfer<D>::template momenta<NPP>(as, npp, mv, mC, am);
-#pragma GCC unroll 16
-      for (int k = 0; k < npp; ++k) {
-        const size_t kp = size_t(k) * kBlock + size_t(p);
-        double* r = remap + size_t(st.node[kp]) * D;
-        for (int d = 0; d < D; ++d) r[d] += st.w[kp] * am.at(k, d);
-      }
+      for_each_entry<FORM>(
+          npp, [&](int k) __attribute__((always_inline)) {
+            const size_t kp = size_t(k) * kBlock + size_t(p);
+            double* r = remap + size_t(st.node[kp]) * D;
+            for (int d = 0; d < D; ++d) r[d] += st.w[kp] * am.at(k, d);
+          });
     }
     sc.max_v2 = max_v2;
   }
@@ -483,6 +493,10 @@ class SinglePhase : public Scheme<D> {
     const bool apic = affine_on_;  // USL with APIC: the velocities are updated already
     const HeldFaces<D> walls = sim.held_faces;
     double max_v2 = sc.max_v2;
+    // Linear tents with an affine transfer: the gradient is the particle's C_p.
+    const bool store_C = MODE == Gradient::kCurrent && B_ >= 0 && affine_.needs_usf();
+    typename AffineTransfer<D>::Columns C;
+    if (store_C) C = AffineTransfer<D>::columns(P, B_);
     for (int p = 0; p < count; ++p) {
       double l[D][D] = {}, vn[D] = {}, a[D] = {};
       for (int k = 0; k < npp; ++k) {
@@ -497,8 +511,7 @@ class SinglePhase : public Scheme<D> {
         }
       }
       store_velocity_gradient<D>(l, L, p);
-      if (MODE == Gradient::kCurrent && B_ >= 0 && affine_.needs_usf())  // linear: C_p
-        affine_.store(P, B_, b + size_t(p), l);
+      if (store_C) C.store(b + size_t(p), l);
       update_volume_and_deformation<D>(l, dt, V[p], F, p);
       if constexpr (kMove)
         for (int d = 0; d < D; ++d) x[size_t(d)][p] = walls.moved(d, x[size_t(d)][p], dt * vn[d]);

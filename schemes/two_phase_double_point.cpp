@@ -417,10 +417,13 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     sim.timed("p2g", [&] { liquid_cell_volumes(sim); });
     sim.timed("p2g", [&] {
       sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-        if (&s == &sim.sets[kSolid])
-          scatter_solid<NPP>(sim, s, b, c, t);
-        else
-          scatter_liquid<NPP>(sim, s, b, c, t);
+        with_form<NPP>(sim, s, b, c, t, [&](auto form) {
+          constexpr AffineForm F = decltype(form)::value;
+          if (&s == &sim.sets[kSolid])
+            scatter_solid<NPP, F>(sim, s, b, c, t);
+          else
+            scatter_liquid<NPP, F>(sim, s, b, c, t);
+        });
       });
     });
     sim.complete_nodes({{node_.data(), S, S}});
@@ -430,7 +433,10 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     sim.timed("grid", [&] { zero_nodes(remap_, sim.threads); });
     sim.timed("g2p_velocity_remap", [&] {
       sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-        remap<NPP>(sim, s, &s == &sim.sets[kSolid] ? kSolid : kLiquid, dt, b, c, t);
+        with_form<NPP>(sim, s, b, c, t, [&](auto form) {
+          remap<NPP, decltype(form)::value>(s, &s == &sim.sets[kSolid] ? kSolid : kLiquid, dt, b, c,
+                                            t);
+        });
       });
     });
     sim.complete_nodes({{remap_.data(), 2 * D, 2 * D}});
@@ -478,23 +484,33 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   /// Solid points: mass, momentum, force (effective stress, weight, loads), drag, solid volume.
   /// APIC: point i's stencil geometry at its position and its affine momenta per unit weight
   /// of every stencil entry, m v_p + m B_p D_p^-1 (x_I - x_p) (mass m, momentum mv).
-  template <int NPP>
-  using Momenta = typename AffineTransfer<D>::template Momenta<NPP>;
-  template <int NPP>
-  void affine_momenta(const Particles<D>& P, const StencilBlock<D>& st, int p, size_t i, int npp,
-                      double m, const double (&mv)[D], AffineStencil& as, Momenta<NPP>& am) const {
+  template <int NPP, AffineForm FORM>
+  using Momenta = typename AffineTransfer<D>::template Momenta<NPP, FORM>;
+  template <int NPP, AffineForm FORM>
+  void affine_momenta(const Particles<D>& P, const typename AffineTransfer<D>::Columns& B,
+                      const StencilBlock<D>& st, int p, size_t i, int npp, double m,
+                      const double (&mv)[D], AffineStencil& as, Momenta<NPP, FORM>& am) const {
     double mC[D][D];
     affine_.stencil(P, st, p, i, npp, as);
-    affine_.matrix(P, B_, i, m, as, mC);
+    affine_.matrix(B, i, m, as, mC);
     AffineTransfer<D>::template momenta<NPP>(as, npp, mv, mC, am);
   }
 
-  template <int NPP>
+  /// Block b's stencil evaluated (with the affine geometry when APIC or TPIC is on) and
+  /// kernel(form) called with its AffineForm: each pass's loop is compiled per form.
+  template <int NPP, class Kernel>
+  void with_form(Simulation<D>& sim, ParticleSet<D>& s, size_t b, int count, int thread,
+                 Kernel&& kernel) {
+    affine_.template evaluate_with_form<NPP>(sim, s.particles, b, count,
+                                             scratch_[size_t(thread)]->stencil, affine_on_, kernel);
+  }
+
+  template <int NPP, AffineForm FORM>
   void scatter_solid(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
+    constexpr bool AFFINE = FORM != AffineForm::kOff;
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
-    StencilBlock<D>& st = sc.stencil;
-    affine_.evaluate(sim, P, b, count, st, affine_on_);
+    const StencilBlock<D>& st = sc.stencil;
     const int npp = NPP ? NPP : st.npp;
     const double* ms = P.col(P.mass) + b;
     const double* V = P.col(P.volume) + b;
@@ -502,7 +518,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     drag_coefficients(P, st, b, count, npp, sc.Q.data());
     double* g = node_.data();
     AffineStencil as;
-    Momenta<NPP> am;  // APIC: the momenta per unit weight
+    Momenta<NPP, FORM> am;  // APIC: the momenta per unit weight
+    typename AffineTransfer<D>::Columns B;
+    if constexpr (AFFINE) B = AffineTransfer<D>::columns(P, B_);
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       double mv[D], body[D], sv[D][D];
@@ -512,24 +530,25 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         body[d] = ms[p] * sim.gravity[size_t(d)] + fe;
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * P.col(P.stress, voigt_index(d, j))[i];
       }
-      if (affine_on_) affine_momenta<NPP>(P, st, p, i, npp, ms[p], mv, as, am);
+      if constexpr (AFFINE) affine_momenta<NPP>(P, B, st, p, i, npp, ms[p], mv, as, am);
       const double vq = V[p] * sc.Q[size_t(p)], vs = (1 - n[p]) * V[p];
       cell_solid_[particle_cell(sim.grid, P, i)] += vs;  // in the stencil: race-free
-      for (int k = 0; k < npp; ++k) {
-        const size_t kp = size_t(k) * kBlock + size_t(p);
-        const double w = st.w[kp];
-        double* r = g + size_t(st.node[kp]) * S;
-        r[kMs] += w * ms[p];
-        r[kQ] += w * vq;
-        r[kN] += w * vs;
-        for (int d = 0; d < D; ++d) {
-          r[kV + d] += w * (affine_on_ ? am.at(k, d) : mv[d]);  // APIC: the affine momentum
-          double f = w * body[d];
-          for (int j = 0; j < D; ++j)
-            f -= sv[d][j] * st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
-          r[kF + d] += f;
-        }
-      }
+      for_each_entry<FORM>(
+          npp, [&](int k) __attribute__((always_inline)) {
+            const size_t kp = size_t(k) * kBlock + size_t(p);
+            const double w = st.w[kp];
+            double* r = g + size_t(st.node[kp]) * S;
+            r[kMs] += w * ms[p];
+            r[kQ] += w * vq;
+            r[kN] += w * vs;
+            for (int d = 0; d < D; ++d) {
+              r[kV + d] += w * (AFFINE ? am.at(k, d) : mv[d]);  // APIC: the affine momentum
+              double f = w * body[d];
+              for (int j = 0; j < D; ++j)
+                f -= sv[d][j] * st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
+              r[kF + d] += f;
+            }
+          });
     }
   }
 
@@ -560,18 +579,20 @@ class TwoPhaseDoublePoint : public Scheme<D> {
 
   /// Liquid points: mass, momentum, weight and loads, and the weak form of div sigma_w over
   /// the mixture volume V/n.
-  template <int NPP>
+  template <int NPP, AffineForm FORM>
   void scatter_liquid(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
+    constexpr bool AFFINE = FORM != AffineForm::kOff;
     Particles<D>& P = set.particles;
-    StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
-    affine_.evaluate(sim, P, b, count, st, affine_on_);
+    const StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
     const int npp = NPP ? NPP : st.npp;
     const double* mw = P.col(P.mass) + b;
     const double* V = P.col(P.volume) + b;
     double* n = P.col(n_) + b;
     double* g = node_.data();
     AffineStencil as;
-    Momenta<NPP> am;  // APIC: the momenta per unit weight
+    Momenta<NPP, FORM> am;  // APIC: the momenta per unit weight
+    typename AffineTransfer<D>::Columns B;
+    if constexpr (AFFINE) B = AffineTransfer<D>::columns(P, B_);
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       n[p] = liquid_porosity(liquid_cell_[i]);  // the solid set is scattered first
@@ -583,21 +604,22 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         body[d] = mw[p] * sim.gravity[size_t(d)] + fe;
         for (int j = 0; j < D; ++j) sv[d][j] = Vmix * P.col(P.stress, voigt_index(d, j))[i];
       }
-      if (affine_on_) affine_momenta<NPP>(P, st, p, i, npp, mw[p], mv, as, am);
-      for (int k = 0; k < npp; ++k) {
-        const size_t kp = size_t(k) * kBlock + size_t(p);
-        const double w = st.w[kp];
-        double* r = g + size_t(st.node[kp]) * S;
-        r[kMw] += w * mw[p];
-        for (int d = 0; d < D; ++d) {
-          r[kW + d] += w * (affine_on_ ? am.at(k, d) : mv[d]);  // APIC: the affine momentum
-          r[kFw + d] += w * body[d];
-          double f = 0;
-          for (int j = 0; j < D; ++j)
-            f -= sv[d][j] * st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
-          r[kG + d] += f;
-        }
-      }
+      if constexpr (AFFINE) affine_momenta<NPP>(P, B, st, p, i, npp, mw[p], mv, as, am);
+      for_each_entry<FORM>(
+          npp, [&](int k) __attribute__((always_inline)) {
+            const size_t kp = size_t(k) * kBlock + size_t(p);
+            const double w = st.w[kp];
+            double* r = g + size_t(st.node[kp]) * S;
+            r[kMw] += w * mw[p];
+            for (int d = 0; d < D; ++d) {
+              r[kW + d] += w * (AFFINE ? am.at(k, d) : mv[d]);  // APIC: the affine momentum
+              r[kFw + d] += w * body[d];
+              double f = 0;
+              for (int j = 0; j < D; ++j)
+                f -= sv[d][j] * st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
+              r[kG + d] += f;
+            }
+          });
     }
   }
 
@@ -696,13 +718,12 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   /// MUSL first pass for the points of one phase: FLIP/PIC update of their velocity from the
   /// phase's nodal velocity and acceleration, the move dt v_grid kept for the gradient pass,
   /// and the scatter of the new momentum (the points stay at x^n).
-  template <int NPP>
-  void remap(Simulation<D>& sim, ParticleSet<D>& set, int phase, double dt, size_t b, int count,
-             int thread) {
+  template <int NPP, AffineForm FORM>
+  void remap(ParticleSet<D>& set, int phase, double dt, size_t b, int count, int thread) {
+    constexpr bool AFFINE = FORM != AffineForm::kOff;
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
-    StencilBlock<D>& st = sc.stencil;
-    affine_.evaluate(sim, P, b, count, st, affine_on_);
+    const StencilBlock<D>& st = sc.stencil;
     const int npp = NPP ? NPP : st.npp;
     const int kv = phase == kSolid ? kV : kW, ka = phase == kSolid ? kF : kFw;
     const double* g = node_.data();
@@ -711,55 +732,57 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     const double flip = flip_;
     double max_v2 = sc.max_v2;
     AffineStencil as;
-    Momenta<NPP> am;  // APIC: the momenta per unit weight
+    Momenta<NPP, FORM> am;  // APIC: the momenta per unit weight
+    typename AffineTransfer<D>::Columns B;
+    if constexpr (AFFINE) B = AffineTransfer<D>::columns(P, B_);
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       double vg[D] = {}, ag[D] = {};
-      for (int k = 0; k < npp; ++k) {
-        const size_t kp = size_t(k) * kBlock + size_t(p);
-        const double w = st.w[kp];
-        const double* r = g + size_t(st.node[kp]) * S;
-        for (int d = 0; d < D; ++d) {
-          vg[d] += w * r[kv + d];
-          ag[d] += w * r[ka + d];
-        }
+      // APIC: B_p = sum_I N_Ip v_I (x_I - x_p)^T at x^n (framework/affine_transfer.hpp).
+      typename AffineTransfer<D>::template MomentSum<NPP, FORM> sum;
+      if constexpr (AFFINE) {
+        sum.clear();
+        affine_.stencil(P, st, p, i, npp, as);
       }
+      for_each_entry<FORM>(
+          npp, [&](int k) __attribute__((always_inline)) {
+            const size_t kp = size_t(k) * kBlock + size_t(p);
+            const double w = st.w[kp];
+            const double* r = g + size_t(st.node[kp]) * S;
+            for (int d = 0; d < D; ++d) {
+              vg[d] += w * r[kv + d];
+              if constexpr (!AFFINE) ag[d] += w * r[ka + d];
+            }
+            if constexpr (AFFINE) affine_.add_moment(sum, st, k, p, w, r + kv, as);
+          });
       double v2 = 0, vp[D];
       for (int d = 0; d < D; ++d) {
         double& v = P.col(P.velocity, d)[i];
-        v = vp[d] = affine_on_ ? vg[d] : flip_pic(flip, v, dt, ag[d], vg[d]);
+        v = vp[d] = AFFINE ? vg[d] : flip_pic(flip, v, dt, ag[d], vg[d]);
         move[size_t(p) * D + size_t(d)] = dt * vg[d];
         v2 += vp[d] * vp[d];
       }
       max_v2 = std::max(max_v2, v2);
-      if (affine_on_) {  // the re-map carries the affine momentum too
-        // B_p = sum_I N_Ip v_I (x_I - x_p)^T at x^n (framework/affine_transfer.hpp), a second
-        // pass over the (cached) stencil's nodes
-        typename AffineTransfer<D>::template MomentSum<NPP> sum;
-        sum.clear();
-        affine_.stencil(P, st, p, i, npp, as);
-        for (int k = 0; k < npp; ++k) {
-          const size_t kp = size_t(k) * kBlock + size_t(p);
-          affine_.add_moment(sum, st, k, p, st.w[kp], g + size_t(st.node[kp]) * S + kv, as);
-        }
-        double B[D][D], mv[D], mC[D][D];
-        affine_.moment(sum, as, B);
-        affine_.store(P, B_, i, B);
+      if constexpr (AFFINE) {  // the re-map carries the affine momentum too
+        double Bp[D][D], mv[D], mC[D][D];
+        affine_.moment(sum, as, Bp);
+        B.store(i, Bp);
         for (int d = 0; d < D; ++d) mv[d] = m[p] * vp[d];
-        affine_.matrix(m[p], B, as, mC);
+        affine_.matrix(m[p], Bp, as, mC);
         AffineTransfer<D>::template momenta<NPP>(as, npp, mv, mC, am);
+        for_each_entry<FORM>(
+            npp, [&](int k) __attribute__((always_inline)) {
+              const size_t kp = size_t(k) * kBlock + size_t(p);
+              double* r = remap_.data() + size_t(st.node[kp]) * 2 * D + size_t(phase * D);
+              for (int d = 0; d < D; ++d) r[d] += st.w[kp] * am.at(k, d);
+            });
+      } else {
         for (int k = 0; k < npp; ++k) {
           const size_t kp = size_t(k) * kBlock + size_t(p);
+          const double wm = st.w[kp] * m[p];
           double* r = remap_.data() + size_t(st.node[kp]) * 2 * D + size_t(phase * D);
-          for (int d = 0; d < D; ++d) r[d] += st.w[kp] * am.at(k, d);
+          for (int d = 0; d < D; ++d) r[d] += wm * vp[d];
         }
-        continue;
-      }
-      for (int k = 0; k < npp; ++k) {
-        const size_t kp = size_t(k) * kBlock + size_t(p);
-        const double wm = st.w[kp] * m[p];
-        double* r = remap_.data() + size_t(st.node[kp]) * 2 * D + size_t(phase * D);
-        for (int d = 0; d < D; ++d) r[d] += wm * vp[d];
       }
     }
     sc.max_v2 = max_v2;

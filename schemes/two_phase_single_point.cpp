@@ -55,6 +55,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 
@@ -219,8 +220,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   void step_phases(Simulation<D>& sim, double dt) {
     sim.timed("grid", [&] { zero_nodes(node_, sim.threads); });
     sim.timed("p2g", [&] {
-      sim.scatter_blocks(
-          [&](ParticleSet<D>& s, size_t b, int c, int t) { scatter<NPP>(sim, s, b, c, t); });
+      sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+        with_form<NPP>(sim, s, b, c, t, affine_on_,
+                       [&](auto form) { scatter<NPP, decltype(form)::value>(sim, s, b, c, t); });
+      });
     });
     sim.complete_nodes({{node_.data(), S, S}});
     sim.timed("grid", [&] { integrate(sim, dt); });
@@ -228,18 +231,24 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     if (musl_) {
       sim.timed("grid", [&] { zero_nodes(remap_, sim.threads); });
       sim.timed("g2p_velocity_remap", [&] {
-        sim.scatter_blocks(
-            [&](ParticleSet<D>& s, size_t b, int c, int t) { remap<NPP>(sim, s, dt, b, c, t); });
+        sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
+          with_form<NPP>(sim, s, b, c, t, affine_on_, [&](auto form) {
+            remap<NPP, decltype(form)::value>(sim, s, dt, b, c, t);
+          });
+        });
       });
       sim.complete_nodes({{remap_.data(), 2 * D, 2 * D}});
       sim.timed("grid", [&] { remapped_velocities(sim); });
     }
     sim.timed("g2p_gradient_stress", [&] {
       sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-        if (musl_)
-          update<NPP, true>(sim, s, dt, b, c, t);
-        else
-          update<NPP, false>(sim, s, dt, b, c, t);
+        // USL takes B_p here (the stencil with the affine geometry), MUSL took it in the re-map.
+        with_form<NPP>(sim, s, b, c, t, affine_on_ && !musl_, [&](auto form) {
+          if (musl_)
+            update<NPP, true, decltype(form)::value>(sim, s, dt, b, c, t);
+          else
+            update<NPP, false, decltype(form)::value>(sim, s, dt, b, c, t);
+        });
       });
     });
     sim.timed("pore_pressure", [&] { apply_pressure_increment(sim); });
@@ -326,95 +335,123 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     }
   }
 
+  /// Block b's stencil evaluated (with the affine geometry when `affine`) and kernel(form)
+  /// called with its AffineForm: each pass's loop is compiled per form.
+  template <int NPP, class Kernel>
+  void with_form(Simulation<D>& sim, ParticleSet<D>& s, size_t b, int count, int thread,
+                 bool affine, Kernel&& kernel) {
+    affine_.template evaluate_with_form<NPP>(sim, s.particles, b, count,
+                                             scratch_[size_t(thread)]->stencil, affine, kernel);
+  }
+
+  /// APIC: both phases' B_p columns (AffineTransfer::Columns), looked up once per block.
+  struct AffineColumns {
+    typename AffineTransfer<D>::Columns s, w;
+  };
+  AffineColumns affine_columns(Particles<D>& P) const {
+    return {AffineTransfer<D>::columns(P, Bs_), AffineTransfer<D>::columns(P, Bw_)};
+  }
+
   /// APIC: the affine momenta per unit weight of both phases of particle i (solid mass ms,
   /// water mass mw) for each of its npp stencil entries, at the stencil geometry `as`.
-  template <int NPP>
-  using Momenta = typename AffineTransfer<D>::template Momenta<NPP>;
-  template <int NPP>
-  void affine_momenta(const Particles<D>& P, size_t i, int npp, double ms, double mw,
-                      const AffineStencil& as, Momenta<NPP>& am_s, Momenta<NPP>& am_w) const {
+  template <int NPP, AffineForm FORM>
+  using Momenta = typename AffineTransfer<D>::template Momenta<NPP, FORM>;
+  template <int NPP, AffineForm FORM>
+  void affine_momenta(const AffineColumns& B, const double (&vs)[D], const double (&vw)[D],
+                      size_t i, int npp, double ms, double mw, const AffineStencil& as,
+                      Momenta<NPP, FORM>& am_s, Momenta<NPP, FORM>& am_w) const {
     double msv[D], mwv[D], mCs[D][D], mCw[D][D];
     for (int d = 0; d < D; ++d) {
-      msv[d] = ms * P.col(P.velocity, d)[i];
-      mwv[d] = mw * P.col(w_, d)[i];
+      msv[d] = ms * vs[d];
+      mwv[d] = mw * vw[d];
     }
-    affine_.matrix(P, Bs_, i, ms, as, mCs);
-    affine_.matrix(P, Bw_, i, mw, as, mCw);
+    affine_.matrix(B.s, i, ms, as, mCs);
+    affine_.matrix(B.w, i, mw, as, mCw);
     AffineTransfer<D>::template momenta<NPP>(as, npp, msv, mCs, am_s);
     AffineTransfer<D>::template momenta<NPP>(as, npp, mwv, mCw, am_w);
   }
 
-  template <int NPP>
+  /// P2G of one evaluated block: both phases' masses and momenta (with an affine FORM, APIC's),
+  /// the drag coefficient, the volume and the mixture's and the water's forces.
+  template <int NPP, AffineForm FORM>
   void scatter(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count, int thread) {
+    constexpr bool AFFINE = FORM != AffineForm::kOff;
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
-    StencilBlock<D>& st = sc.stencil;
-    affine_.evaluate(sim, P, b, count, st, affine_on_);
+    const StencilBlock<D>& st = sc.stencil;
     const int npp = NPP ? NPP : st.npp;
     const double* ms = P.col(P.mass) + b;
     const double* V = P.col(P.volume) + b;
     const double* n = P.col(n_) + b;
     const double* pw = P.col(p_) + b;
+    std::array<const double*, D> v{}, vw{}, fe{};
+    std::array<const double*, NS> sig{};
+    for (int d = 0; d < D; ++d) {
+      v[size_t(d)] = P.col(P.velocity, d) + b;
+      vw[size_t(d)] = P.col(w_, d) + b;
+      fe[size_t(d)] = sim.external_force >= 0 ? P.col(sim.external_force, d) + b : nullptr;
+    }
+    for (int c = 0; c < NS; ++c) sig[size_t(c)] = P.col(P.stress, c) + b;
     // Drag coefficients of the block (relative speeds only for speed-dependent laws).
     double speed[kBlock];
     if (drag_->speed_dependent())
       for (int p = 0; p < count; ++p) {
         double s2 = 0;
         for (int d = 0; d < D; ++d) {
-          const double r = P.col(w_, d)[b + size_t(p)] - P.col(P.velocity, d)[b + size_t(p)];
+          const double r = vw[size_t(d)][p] - v[size_t(d)][p];
           s2 += r * r;
         }
         speed[p] = std::sqrt(s2);
       }
     drag_->coefficient(size_t(count), n, drag_->speed_dependent() ? speed : nullptr, sc.Q.data());
     double* g = node_.data();
+    const std::array<double, D> gravity = sim.gravity;
     AffineStencil as;
-    Momenta<NPP> am_s, am_w;  // APIC: the phases' momenta per unit weight
+    Momenta<NPP, FORM> am_s, am_w;  // APIC: the phases' momenta per unit weight
+    AffineColumns B;
+    if constexpr (AFFINE) B = affine_columns(P);
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       const double mw = n[p] * rho_w_ * V[p];
-      double vs[D], vw[D], body[D], sv[D][D];
-      if (affine_on_) {
-        affine_.stencil(P, st, p, i, npp, as);
-        affine_momenta<NPP>(P, i, npp, ms[p], mw, as, am_s, am_w);
-      }
+      double vs[D], vwp[D], body[D], sv[D][D];
       for (int d = 0; d < D; ++d) {
-        vs[d] = P.col(P.velocity, d)[i];
-        vw[d] = P.col(w_, d)[i];
-        const double fe = sim.external_force >= 0 ? P.col(sim.external_force, d)[i] : 0.0;
-        body[d] = (ms[p] + mw) * sim.gravity[size_t(d)] + fe;
+        vs[d] = v[size_t(d)][p];
+        vwp[d] = vw[size_t(d)][p];
+        body[d] = (ms[p] + mw) * gravity[size_t(d)] + (fe[size_t(d)] ? fe[size_t(d)][p] : 0.0);
         for (int j = 0; j < D; ++j)
-          sv[d][j] = V[p] * (P.col(P.stress, voigt_index(d, j))[i] - (d == j ? pw[p] : 0.0));
+          sv[d][j] = V[p] * (sig[size_t(voigt_index(d, j))][p] - (d == j ? pw[p] : 0.0));
+      }
+      if constexpr (AFFINE) {
+        affine_.stencil(P, st, p, i, npp, as);
+        affine_momenta<NPP>(B, vs, vwp, i, npp, ms[p], mw, as, am_s, am_w);
       }
       const double vp = V[p] * pw[p], vq = V[p] * sc.Q[size_t(p)];
-      for (int k = 0; k < npp; ++k) {
-        const size_t kp = size_t(k) * kBlock + size_t(p);
-        const double w = st.w[kp];
-        double* r = g + size_t(st.node[kp]) * S;
-        r[kMs] += w * ms[p];
-        r[kMw] += w * mw;
-        r[kQ] += w * vq;
-        r[kN] += w * V[p];  // volume; the nodal porosity m_w / (rho_w V_I) in integrate()
-        double gr[D];
-        for (int j = 0; j < D; ++j)
-          gr[j] = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
-        if (affine_on_) {  // the phases' affine momenta
-          for (int d = 0; d < D; ++d) {
-            r[kV + d] += w * am_s.at(k, d);
-            r[kW + d] += w * am_w.at(k, d);
-          }
-        }
-        for (int d = 0; d < D; ++d) {
-          if (!affine_on_) {
-            r[kV + d] += w * ms[p] * vs[d];
-            r[kW + d] += w * mw * vw[d];
-          }
-          double f = w * body[d];
-          for (int j = 0; j < D; ++j) f -= sv[d][j] * gr[j];
-          r[kF + d] += f;
-          r[kFw + d] += vp * gr[d];  // the water's weight is added per node
-        }
-      }
+      for_each_entry<FORM>(
+          npp, [&](int k) __attribute__((always_inline)) {
+            const size_t kp = size_t(k) * kBlock + size_t(p);
+            const double w = st.w[kp];
+            double* r = g + size_t(st.node[kp]) * S;
+            r[kMs] += w * ms[p];
+            r[kMw] += w * mw;
+            r[kQ] += w * vq;
+            r[kN] += w * V[p];  // volume; the nodal porosity m_w / (rho_w V_I) in integrate()
+            double gr[D];
+            for (int j = 0; j < D; ++j)
+              gr[j] = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
+            for (int d = 0; d < D; ++d) {
+              if constexpr (AFFINE) {  // the phases' affine momenta
+                r[kV + d] += w * am_s.at(k, d);
+                r[kW + d] += w * am_w.at(k, d);
+              } else {
+                r[kV + d] += w * ms[p] * vs[d];
+                r[kW + d] += w * mw * vwp[d];
+              }
+              double f = w * body[d];
+              for (int j = 0; j < D; ++j) f -= sv[d][j] * gr[j];
+              r[kF + d] += f;
+              r[kFw + d] += vp * gr[d];  // the water's weight is added per node
+            }
+          });
     }
   }
 
@@ -512,39 +549,43 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// here would make the gradient pass evaluate the stencil at x^{n+1} against velocities
   /// re-mapped with the weights at x^n, so that a node without mass at x^n contributes zero
   /// velocity: a rigidly translating block then showed |p| up to 7.9e5 Pa.
-  template <int NPP>
+  template <int NPP, AffineForm FORM>
   void remap(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count, int thread) {
+    constexpr bool AFFINE = FORM != AffineForm::kOff;
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
-    StencilBlock<D>& st = sc.stencil;
-    affine_.evaluate(sim, P, b, count, st, affine_on_);
+    const StencilBlock<D>& st = sc.stencil;
     const int npp = NPP ? NPP : st.npp;
     double max_v2 = sc.max_v2;
     AffineStencil as;
-    Momenta<NPP> am_s, am_w;  // APIC: the phases' momenta per unit weight
+    Momenta<NPP, FORM> am_s, am_w;  // APIC: the phases' momenta per unit weight
+    AffineColumns B;
+    if constexpr (AFFINE) B = affine_columns(P);
+    const double* m = P.col(P.mass);
+    const double* V = P.col(P.volume);
+    const double* n = P.col(n_);
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
-      max_v2 =
-          std::max(max_v2, velocity_update<NPP, false>(sim, P, st, p, i, npp, dt, &move_[i * D],
-                                                       affine_on_ ? &as : nullptr));
-      const double ms = P.col(P.mass)[i], mw = P.col(n_)[i] * rho_w_ * P.col(P.volume)[i];
+      double vs[D], vw[D];
+      max_v2 = std::max(max_v2, velocity_update<NPP, false, FORM>(sim, P, st, p, i, npp, dt,
+                                                                  &move_[i * D], vs, vw, &as, B));
+      const double ms = m[i], mw = n[i] * rho_w_ * V[i];
       // The re-map carries the affine momenta, with D_p at x^n (as the scatter).
-      if (affine_on_) affine_momenta<NPP>(P, i, npp, ms, mw, as, am_s, am_w);
-      for (int k = 0; k < npp; ++k) {
-        const size_t kp = size_t(k) * kBlock + size_t(p);
-        double* r = remap_.data() + size_t(st.node[kp]) * 2 * D;
-        if (affine_on_) {
-          for (int d = 0; d < D; ++d) {
-            r[d] += st.w[kp] * am_s.at(k, d);
-            r[D + d] += st.w[kp] * am_w.at(k, d);
-          }
-        } else {
-          for (int d = 0; d < D; ++d) {
-            r[d] += st.w[kp] * ms * P.col(P.velocity, d)[i];
-            r[D + d] += st.w[kp] * mw * P.col(w_, d)[i];
-          }
-        }
-      }
+      if constexpr (AFFINE) affine_momenta<NPP>(B, vs, vw, i, npp, ms, mw, as, am_s, am_w);
+      for_each_entry<FORM>(
+          npp, [&](int k) __attribute__((always_inline)) {
+            const size_t kp = size_t(k) * kBlock + size_t(p);
+            double* r = remap_.data() + size_t(st.node[kp]) * 2 * D;
+            for (int d = 0; d < D; ++d) {
+              if constexpr (AFFINE) {
+                r[d] += st.w[kp] * am_s.at(k, d);
+                r[D + d] += st.w[kp] * am_w.at(k, d);
+              } else {
+                r[d] += st.w[kp] * ms * vs[d];
+                r[D + d] += st.w[kp] * mw * vw[d];
+              }
+            }
+          });
     }
     sc.max_v2 = max_v2;
   }
@@ -568,53 +609,60 @@ class TwoPhaseSinglePoint : public Scheme<D> {
 
   /// Particle p (index i) of a block: FLIP/PIC update of v and w from the grid record and its
   /// move dt v_grid with the solid grid velocity: done now with MOVE (kept inside the held
-  /// faces), else stored in `move` (D values) for the gradient pass; returns |v|^2. With APIC
-  /// (`as` given): v and w from the grid velocities and both B_p, taken at x^n before the move
-  /// (framework/affine_transfer.hpp), `as` left holding the stencil geometry there.
-  template <int NPP, bool MOVE>
+  /// faces), else stored in `move` (D values) for the gradient pass; the new velocities also in
+  /// vs, vw; returns |v|^2. With an affine FORM: v and w from the grid velocities and both B_p
+  /// (into the columns B), taken at x^n before the move (framework/affine_transfer.hpp), `as`
+  /// left holding the stencil geometry there.
+  template <int NPP, bool MOVE, AffineForm FORM>
   double velocity_update(const Simulation<D>& sim, Particles<D>& P, const StencilBlock<D>& st,
-                         int p, size_t i, int npp, double dt, double* move = nullptr,
-                         AffineStencil* as = nullptr) {
+                         int p, size_t i, int npp, double dt, double* move, double (&vs)[D],
+                         double (&vw)[D], AffineStencil* as, const AffineColumns& B) {
+    constexpr bool AFFINE = FORM != AffineForm::kOff;
     double vn[D] = {}, wn[D] = {}, acc_s[D] = {}, acc_w[D] = {};
-    for (int k = 0; k < npp; ++k) {
-      const size_t kp = size_t(k) * kBlock + size_t(p);
-      const double w = st.w[kp];
-      const double* r = node_.data() + size_t(st.node[kp]) * S;
-      for (int d = 0; d < D; ++d) {
-        vn[d] += w * r[kV + d];
-        wn[d] += w * r[kW + d];
-        acc_s[d] += w * r[kF + d];
-        acc_w[d] += w * r[kFw + d];
-      }
-    }
-    if (as) {  // both phases' B_p, a second pass over the (cached) stencil's nodes
-      typename AffineTransfer<D>::template MomentSum<NPP> sum_s, sum_w;
+    typename AffineTransfer<D>::template MomentSum<NPP, FORM> sum_s, sum_w;  // both phases' B_p
+    if constexpr (AFFINE) {
       sum_s.clear();
       sum_w.clear();
       affine_.stencil(P, st, p, i, npp, *as);
-      for (int k = 0; k < npp; ++k) {
-        const size_t kp = size_t(k) * kBlock + size_t(p);
-        const double* r = node_.data() + size_t(st.node[kp]) * S;
-        affine_.add_moment(sum_s, st, k, p, st.w[kp], r + kV, *as);
-        affine_.add_moment(sum_w, st, k, p, st.w[kp], r + kW, *as);
-      }
+    }
+    for_each_entry<FORM>(
+        npp, [&](int k) __attribute__((always_inline)) {
+          const size_t kp = size_t(k) * kBlock + size_t(p);
+          const double w = st.w[kp];
+          const double* r = node_.data() + size_t(st.node[kp]) * S;
+          for (int d = 0; d < D; ++d) {
+            vn[d] += w * r[kV + d];
+            wn[d] += w * r[kW + d];
+            if constexpr (!AFFINE) {
+              acc_s[d] += w * r[kF + d];
+              acc_w[d] += w * r[kFw + d];
+            }
+          }
+          if constexpr (AFFINE) {
+            affine_.add_moment(sum_s, st, k, p, w, r + kV, *as);
+            affine_.add_moment(sum_w, st, k, p, w, r + kW, *as);
+          }
+        });
+    if constexpr (AFFINE) {
       double Bs[D][D], Bw[D][D];
       affine_.moment(sum_s, *as, Bs);
       affine_.moment(sum_w, *as, Bw);
-      affine_.store(P, Bs_, i, Bs);
-      affine_.store(P, Bw_, i, Bw);
+      B.s.store(i, Bs);
+      B.w.store(i, Bw);
     }
     double v2 = 0;
     for (int d = 0; d < D; ++d) {
       double& v = P.col(P.velocity, d)[i];
       double& w = P.col(w_, d)[i];
-      if (as) {
+      if constexpr (AFFINE) {
         v = vn[d];
         w = wn[d];
       } else {
         v = flip_pic(flip_, v, dt, acc_s[d], vn[d]);
         w = flip_pic(flip_, w, dt, acc_w[d], wn[d]);
       }
+      vs[d] = v;
+      vw[d] = w;
       if constexpr (MOVE)
         P.col(P.position, d)[i] = sim.held_faces.moved(d, P.col(P.position, d)[i], dt * vn[d]);
       else
@@ -624,13 +672,17 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     return v2;
   }
 
-  template <int NPP, bool REMAPPED>
+  /// The gradient pass of one evaluated block (USL: with the velocity update, affine FORM as
+  /// velocity_update; MUSL: FORM kOff, B_p was taken in the re-map): L of both phases, the
+  /// move, volume, F, porosity and the storage equation, then the stress update.
+  template <int NPP, bool REMAPPED, AffineForm FORM>
   void update(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count, int thread) {
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
-    StencilBlock<D>& st = sc.stencil;
-    affine_.evaluate(sim, P, b, count, st, affine_on_ && !REMAPPED);
+    const StencilBlock<D>& st = sc.stencil;
     const int npp = NPP ? NPP : st.npp;
+    AffineColumns B;
+    if constexpr (FORM != AffineForm::kOff) B = affine_columns(P);
     const double* g = node_.data();
     double* L = sc.L.data();
     double max_v2 = sc.max_v2;
@@ -640,9 +692,11 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       const size_t i = b + size_t(p);
       // USL: the velocity update happens here; MUSL did it in the re-map pass.
       // (the stencil was evaluated at x^n above, so moving here does not change it).
-      if constexpr (!REMAPPED)
-        max_v2 = std::max(max_v2, velocity_update<NPP, true>(sim, P, st, p, i, npp, dt, nullptr,
-                                                             affine_on_ ? &as : nullptr));
+      if constexpr (!REMAPPED) {
+        double vs[D], vw[D];
+        max_v2 = std::max(max_v2, velocity_update<NPP, true, FORM>(sim, P, st, p, i, npp, dt,
+                                                                   nullptr, vs, vw, &as, B));
+      }
       double ls[D][D] = {}, lw[D][D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
