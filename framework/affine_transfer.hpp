@@ -361,21 +361,19 @@ class AffineTransfer {
   LOAM_FORCE_INLINE void add_moment(MomentSum<NPP, F>& sum, const StencilBlock<D>& st, int k, int p,
                                     double w, const double* vI, const Stencil& s) const {
     constexpr int M = MomentSum<NPP, F>::M;
-    if constexpr (MomentSum<NPP, F>::kProduct) {  // with_form checked the block
-      for (int e = 0, r = k; e < D; ++e, r /= M)
-        for (int d = 0; d < D; ++d) sum.axis[e][r % M][d] += w * vI[d];
-      return;
-    }
-    if (usf_gradient_) return;
-    if (gradient_form_) {
-      for (int j = 0; j < D; ++j) {
-        const double g = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
-        for (int d = 0; d < D; ++d) sum.B[d][j] += vI[d] * g;
+    constexpr bool kProduct = MomentSum<NPP, F>::kProduct;  // with_form checked the block
+    if constexpr (!kProduct) {
+      if (usf_gradient_) return;
+      if (gradient_form_) {
+        for (int j = 0; j < D; ++j) {
+          const double g = st.grad[(size_t(k) * D + size_t(j)) * kBlock + size_t(p)];
+          for (int d = 0; d < D; ++d) sum.B[d][j] += vI[d] * g;
+        }
+        return;
       }
-      return;
     }
     if constexpr (M > 0) {
-      if (s.m == M) {
+      if (kProduct || s.m == M) {
         for (int e = 0, r = k; e < D; ++e, r /= M)
           for (int d = 0; d < D; ++d) sum.axis[e][r % M][d] += w * vI[d];
         return;
