@@ -203,11 +203,11 @@ class SinglePhase : public Scheme<D> {
   void update_velocities(Simulation<D>& sim, double dt) {
     auto f = [&](ParticleSet<D>& s, size_t b, int c, int t) {
       if (!affine_on_) return update_velocity<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
-      affine_.template evaluate_with_form<NPP>(
-          sim, s.particles, b, c, scratch_[size_t(t)]->stencil, true, [&](auto form) {
-            if constexpr (decltype(form)::value != AffineForm::kOff)
-              update_velocity_apic<NPP, REMAP, MOVE, decltype(form)::value>(sim, s, dt, b, c, t);
-          });
+      StencilBlock<D>& st = scratch_[size_t(t)]->stencil;
+      affine_.evaluate(sim, s.particles, b, c, st);
+      affine_.template with_form<NPP>(st, [&](auto form) {
+        update_velocity_apic<NPP, REMAP, MOVE, decltype(form)::value>(sim, s, dt, b, c, t);
+      });
     };
     if constexpr (REMAP)
       sim.scatter_blocks(f);

@@ -244,10 +244,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
         // USL takes B_p here (the stencil with the affine geometry), MUSL took it in the re-map.
         with_form<NPP>(sim, s, b, c, t, affine_on_ && !musl_, [&](auto form) {
-          if (musl_)
-            update<NPP, true, decltype(form)::value>(sim, s, dt, b, c, t);
-          else
-            update<NPP, false, decltype(form)::value>(sim, s, dt, b, c, t);
+          constexpr AffineForm F = decltype(form)::value;
+          if constexpr (F == AffineForm::kOff)
+            if (musl_) return update<NPP, true, F>(sim, s, dt, b, c, t);
+          update<NPP, false, F>(sim, s, dt, b, c, t);
         });
       });
     });
@@ -677,6 +677,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// move, volume, F, porosity and the storage equation, then the stress update.
   template <int NPP, bool REMAPPED, AffineForm FORM>
   void update(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count, int thread) {
+    static_assert(!REMAPPED || FORM == AffineForm::kOff, "MUSL takes B_p in the re-map");
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     const StencilBlock<D>& st = sc.stencil;
