@@ -70,10 +70,12 @@ Schema stage_schema() {
   st.string_list("deactivate",
                  "bodies whose particles leave the run at the stage's start (excavation)")
       .def("[]");
-  st.string_list("reset",
-                 "what is reset at the stage's start: displacement (the reference of the "
-                 "displacement output and of max_displacement becomes the current position), "
-                 "velocity (every phase), plastic_strain (plastic_strain_eq)")
+  st.string_list(
+        "reset",
+        "what is reset at the stage's start: displacement (the reference of the "
+        "displacement output and of max_displacement becomes the current position), "
+        "velocity (every phase), plastic_strain (the output plastic_strain_eq; no material "
+        "state: a softened material stays softened)")
       .def("[]");
   {
     Schema o;

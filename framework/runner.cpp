@@ -463,7 +463,8 @@ std::string Run<D>::resume_layout_hint(const fs::path& dir) const {
       continue;
     }
   }
-  return "";
+  return " (a run writes one when it is interrupted by Ctrl-C or SIGTERM, and with "
+         "output.checkpoint every_steps or every_wall_seconds)";
 }
 
 template <int D>
@@ -799,12 +800,18 @@ RunResult Run<D>::loop() {
              {"reason", "the stages did not end in a static state (see stages[])"}};
     }
   }
-  if (interrupted && files)  // the state after the last complete step, as a regular frame
+  // The state after the last complete step, as a regular frame, and a checkpoint to resume
+  // from, also without output.checkpoint (the resumed run removes it when it ends).
+  bool resumable = false;
+  if (interrupted && files)
     guarded([&] {
       if (ls_.frame_step != sim.step) write_frame("");
       sample_probes(true);
       if (ls_.history_step != sim.step) write_history();
-      if (checkpointing()) write_checkpoint(checkpoint_image());
+      if (checkpoint_problem().empty()) {
+        write_checkpoint(checkpoint_image());
+        resumable = true;
+      }
     });
   double wall = std::chrono::duration<double>(Clock::now() - t0).count();
   res.summary = base_summary();
@@ -908,6 +915,7 @@ RunResult Run<D>::loop() {
                   (files ? ": the last complete step was written as the last frame, with the "
                            "history, probes and summary.json (status: interrupted)"
                          : "") +
+                  (resumable ? "; go on with: loam run CONFIG --resume " + dir_.string() : "") +
                   "\n";
   }
   if (files) {
@@ -945,6 +953,13 @@ RunResult Run<D>::loop() {
       }
     }
   }
+  // A run that was not asked for checkpoints keeps none once it has ended: the one its
+  // interruption left was only for --resume.
+  if (files && res.exit_code == 0 && !checkpointing())
+    for (const auto& file : checkpoints_) {
+      std::error_code ec;
+      fs::remove(file, ec);
+    }
   if (!opt_.quiet && opt_.report && failure.empty() && !interrupted)
     spdlog::info(
         "done: {} steps, {} particles, {:.3g} s wall, {:.3g} M particle-steps/s on {} thread(s){}",

@@ -20,6 +20,11 @@ class Diagnostics;
 
 constexpr int kBlock = 64;
 
+/// The per-cell pressure space stable with a shape function's velocity space (the two-phase
+/// schemes' pressure_smoothing: cell; framework/cell_projection.hpp): one value per cell
+/// (Q1-P0) or a linear function per cell (Q2-P1disc).
+enum class CellPressure { kConstant, kLinear };
+
 template <int D>
 struct StencilBlock {
   static constexpr int dimension = D;
@@ -106,6 +111,11 @@ class ShapeFunction {
   /// and CPDI, whose weights are the hat averaged over a particle domain inside the grid, share
   /// it.
   virtual double axis_node_volume(int i, int last) const { return i == 0 || i == last ? 0.5 : 1.0; }
+  /// The per-cell pressure space that its nodal forces can balance (framework/cell_projection.hpp):
+  /// constant where a cell's nodal forces depend only on its particles' mean pressure (the
+  /// linear tents; GIMP and CPDI integrate the tents' gradients), linear where the gradients
+  /// vary inside a cell (quadratic B-splines).
+  virtual CellPressure cell_pressure() const { return CellPressure::kConstant; }
   /// Fill `out` for particles [begin, begin + count), count <= kBlock. Stencil entries for nodes
   /// outside the grid must carry a valid node index with zero weight and gradient.
   virtual void evaluate(const Grid<D>& grid, const Particles<D>& particles, size_t begin, int count,

@@ -37,8 +37,18 @@ void Run<D>::check_strength_reduction(Diagnostics& diag) {
   const auto& bl = cfg_.params.list("bodies");
   const auto& names = r.strings("bodies");
   srf_bodies_.clear();
-  for (size_t b = 0; names.empty() && b < bl.size(); ++b)
-    if (final_material(sim, int(b)).reduced(1.0)) srf_bodies_.push_back(int(b));
+  std::string left_out;
+  for (size_t b = 0; names.empty() && b < bl.size(); ++b) {
+    if (final_material(sim, int(b)).reduced(1.0))
+      srf_bodies_.push_back(int(b));
+    else
+      left_out += (left_out.empty() ? "'" : ", '") + sim.bodies[b].name + "'";
+  }
+  if (!left_out.empty() && !srf_bodies_.empty())
+    spdlog::warn(
+        "strength reduction leaves out {}: no strength to reduce (an elastic or fluid "
+        "model after the last stage)",
+        left_out);
   if (names.empty() && srf_bodies_.empty())
     diag.error(r.where(), r.path(),
                "no body's material has a strength to reduce (elastic and fluid models have "

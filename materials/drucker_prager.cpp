@@ -11,8 +11,18 @@
 //   compression (outer cone, through MC's triaxial-compression corners; the default):
 //     eta = 6 sin phi / (sqrt3 (3 - sin phi)),  xi = 6 cos phi / (sqrt3 (3 - sin phi));
 //   extension (inner cone, through the triaxial-extension corners): 3 + sin phi instead;
-//   plane_strain (the plane-strain collapse load of associated MC, tan phi = t):
-//     eta = 3 t / sqrt(9 + 12 t^2),  xi = 3 / sqrt(9 + 12 t^2).
+//   plane_strain (the plane-strain strength of MC with the same dilation angle): at a plane-
+//     strain limit state the out-of-plane plastic strain rate vanishes, s_zz = -(2/3) eta_bar
+//     sqrt(J2), so sqrt(J2) = t / sqrt(1 - eta_bar^2/3) and p = s_m - eta_bar sqrt(J2)/3, with
+//     t = (sigma_1 - sigma_3)/2 and s_m = (sigma_1 + sigma_3)/2 in the plane. f = 0 is then MC's
+//     t = c cos phi - s_m sin phi when
+//       eta_bar = 3 sin psi / sqrt(9 + 3 sin^2 psi)   (the in-plane dilation angle is psi),
+//       eta = sin phi / (sqrt(1 - eta_bar^2/3) + eta_bar sin phi / 3),
+//       xi = cos phi (1 - eta eta_bar / 3) / sqrt(1 - eta_bar^2/3).
+//     Associated (psi = phi) this is eta = 3 tan phi / sqrt(9 + 12 tan^2 phi), xi = 3 /
+//     sqrt(9 + 12 tan^2 phi) (de Souza Neto et al. 2008, section 6.4.6); psi = 0 gives eta =
+//     sin phi, xi = cos phi. Matching the associated cone for psi < phi overestimates the
+//     strength: simple shear at phi = 30, psi = 0 gave tau/sigma_n 0.4799 against MC's 0.5.
 // With compression matching a drained triaxial compression fails at MC's peak and dilates at
 // d eps_v / d eps_1 = -2 sin psi / (1 - sin psi), as MC does (tests/test_drucker_prager.cpp).
 //
@@ -40,18 +50,23 @@
 
 namespace loam {
 
-/// The Drucker-Prager cone matched to Mohr-Coulomb: slope eta and cohesion factor xi of
-/// f = sqrt(J2) + eta p - xi c for an angle in degrees (phi for f, psi for g's eta_bar).
+/// The Drucker-Prager cone matched to Mohr-Coulomb (see the header): slope eta and cohesion
+/// factor xi of f = sqrt(J2) + eta p - xi c, and eta_bar of g = sqrt(J2) + eta_bar p, for
+/// phi and psi in degrees.
 struct DruckerPragerCone {
-  double eta, xi;
-  static DruckerPragerCone matched(double angle_deg, const std::string& match) {
-    const double a = angle_deg * M_PI / 180.0, s = std::sin(a), c = std::cos(a);
+  double eta, xi, eta_bar;
+  static DruckerPragerCone matched(double phi_deg, double psi_deg, const std::string& match) {
+    const double a = phi_deg * M_PI / 180.0, s = std::sin(a), c = std::cos(a);
+    const double sp = std::sin(psi_deg * M_PI / 180.0);
     if (match == "plane_strain") {
-      const double t = std::tan(a), r = std::sqrt(9 + 12 * t * t);
-      return {3 * t / r, 3 / r};
+      const double eta_bar = 3 * sp / std::sqrt(9 + 3 * sp * sp);
+      const double r = std::sqrt(1 - eta_bar * eta_bar / 3);
+      const double eta = s / (r + eta_bar * s / 3);
+      return {eta, c * (1 - eta * eta_bar / 3) / r, eta_bar};
     }
     const double den = std::sqrt(3.0) * (match == "extension" ? 3 + s : 3 - s);
-    return {6 * s / den, 6 * c / den};
+    const double den_psi = std::sqrt(3.0) * (match == "extension" ? 3 + sp : 3 - sp);
+    return {6 * s / den, 6 * c / den, 6 * sp / den_psi};
   }
 };
 
@@ -73,7 +88,7 @@ class DruckerPrager : public Material<D> {
     s.choice("match", {"compression", "extension", "plane_strain"},
              "which Mohr-Coulomb states the cone passes through: compression (outer cone, "
              "triaxial compression exact), extension (inner cone, triaxial extension exact) or "
-             "plane_strain (the plane-strain strength of associated Mohr-Coulomb)")
+             "plane_strain (Mohr-Coulomb's plane-strain strength for the given psi)")
         .def("compression");
     s.real("tension_cutoff", "Pa",
            "largest mean stress p = tr(sigma)/3 (tension positive); default: the cone's apex "
@@ -137,10 +152,10 @@ class DruckerPrager : public Material<D> {
 
  private:
   void set_strength(double c, double phi, double psi, double cutoff) {
-    const auto f = DruckerPragerCone::matched(phi, match_);
+    const auto f = DruckerPragerCone::matched(phi, psi, match_);
     eta_ = f.eta;
     xi_c_ = f.xi * c;
-    eta_bar_ = DruckerPragerCone::matched(psi, match_).eta;
+    eta_bar_ = f.eta_bar;
     const double apex = eta_ > 0 ? xi_c_ / eta_ : std::numeric_limits<double>::infinity();
     cutoff_ = std::min(cutoff, apex);
   }

@@ -61,6 +61,11 @@
 // stress): e = e0 (or v0 - 1); pc = pc0, or pc = ocr * max(p'0, min_pressure) from each
 // particle's initial mean effective stress p'0; in both cases pc is raised, if needed, so that
 // the initial stress lies inside or on the yield surface (pc >= p'0 + q0^2/(M^2 p'0)).
+// Strength reduction (reduced(F), docs/strength_reduction.md): the critical-state strength is
+// q = M p', reduced through its friction angle as Mohr-Coulomb's: sin phi_cs = 3 M / (6 + M)
+// (triaxial compression, Wood 1990, Soil Behaviour and Critical State Soil Mechanics, eq.
+// 7.9), tan phi_F = tan phi_cs / F, M_F = 6 sin phi_F / (3 - sin phi_F); the state (pc, e)
+// is shared. M >= 3 has no friction angle: M / F.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -232,6 +237,19 @@ class ModifiedCamClay : public Material<D> {
       pc[i] = c;
       eq[i] = 0;
     }
+  }
+
+  /// M reduced through the critical-state friction angle (see the header).
+  std::unique_ptr<Material<D>> reduced(double F) const override {
+    auto m = std::make_unique<ModifiedCamClay>(*this);
+    const double s = 3 * M_ / (6 + M_);
+    if (s < 1) {
+      const double sf = std::sin(std::atan(std::tan(std::asin(s)) / F));
+      m->M_ = 6 * sf / (3 - sf);
+    } else {
+      m->M_ = M_ / F;
+    }
+    return m;
   }
 
   double wave_speed(const Particles<D>& P, size_t b, size_t e) const override {

@@ -2,12 +2,14 @@
 // hypoelastic with the Jaumann rate, non-associated Mohr-Coulomb plasticity, optional tension
 // cutoff) whose cohesion c, friction angle phi and dilation angle psi fall linearly from their
 // peak to their residual values as the equivalent plastic deviatoric strain
-//   eps_q^p = sum over steps of sqrt(2/3 e^p : e^p)     (state field plastic_strain_eq)
+//   eps_q^p = sum over steps of sqrt(2/3 e^p : e^p)     (state field softening_strain)
 // grows from softening_start to softening_end (docs/verification.md B; the slope seed uses this):
 //   t = clamp((eps_q^p - softening_start) / (softening_end - softening_start), 0, 1),
 //   c = c_peak + t (c_residual - c_peak), and likewise phi and psi (in degrees).
 // Below softening_start the model is perfectly plastic at peak strength, beyond softening_end
-// perfectly plastic at residual strength.
+// perfectly plastic at residual strength. The state is its own field, softening_strain: the
+// shared output measure plastic_strain_eq accumulates the same increments but a stage's
+// `reset: [plastic_strain]` zeroes it, and that must not heal a softened material.
 //
 // Sign convention: Cauchy stress, TENSION POSITIVE, Voigt xx yy zz xy yz xz (1D: xx yy zz,
 // laterally confined; 2D: plane strain, xx yy zz xy; 3D: all six). Angles in degrees.
@@ -27,7 +29,7 @@
 //      until |r| <= 1e-12 (x_n + deq), at most 60 returns (1 when the parameters are constant
 //      over the step: peak == residual, before softening_start, after softening_end; measured
 //      4.6 on average per softening step on a 5000-step compression path, 15 at most, where a
-//      step crosses softening_end). The stress and plastic_strain_eq += deq are those of the
+//      step crosses softening_end). The stress and softening_strain += deq are those of the
 //      last return: the stress is on the yield surface of parameters taken at a plastic strain
 //      within 1e-12 (x_n + deq) of the new eps_q^p. With peak == residual it is mohr_coulomb,
 //      bit for bit.
@@ -146,6 +148,14 @@ class StrainSofteningMC : public Material<D> {
   void setup(Simulation<D>& sim, int m, Diagnostics&) override {
     const int set = sim.body_set(m);  // state fields live in the set of the body
     eq_ = sim.request_field(plastic_strain_eq_field(), set);
+    state_ = sim.request_field({"softening_strain",
+                                1,
+                                "-",
+                                "equivalent plastic deviatoric strain the strength has softened "
+                                "with (strain_softening_mc's "
+                                "state; a stage's reset leaves it)",
+                                {}},
+                               set);
     scale_ = 1;
     if (length_ > 0) {
       double volume = 1;
@@ -187,10 +197,11 @@ class StrainSofteningMC : public Material<D> {
     double* s[NS];
     for (int c = 0; c < NS; ++c) s[c] = P.col(P.stress, c) + batch.begin;
     double* eq = P.col(eq_) + batch.begin;
+    double* state = P.col(state_) + batch.begin;
     for (int p = 0; p < batch.count; ++p) {
       Eigen::Matrix3d tr = jaumann_trial_stress<D>(s, batch, p, lambda_, G_);
       const MohrCoulombSurface::Principal pr(tr);
-      const double xn = eq[p];
+      const double xn = state[p];
       const MohrCoulombSurface s0 = surface(xn);
       if (s0.elastic(pr.values)) {
         store_stress<D>(s, p, tr);
@@ -201,7 +212,8 @@ class StrainSofteningMC : public Material<D> {
       s0.return_principal(pr.values, sp, deq);
       if (!constant_ && xn < end_ * scale_ && xn + deq > start_ * scale_)
         consistent_return(pr.values, xn, sp, deq);
-      eq[p] = xn + deq;
+      state[p] = xn + deq;
+      eq[p] += deq;
       pr.compose(sp, tr);
       store_stress<D>(s, p, tr);
     }
@@ -238,7 +250,7 @@ class StrainSofteningMC : public Material<D> {
   double length_ = 0, scale_ = 1;  // characteristic_length (0: none), l_c / l_p
   double G_ = 0, lambda_ = 0, M_ = 0;
   bool constant_ = false;
-  int eq_ = -1;
+  int eq_ = -1, state_ = -1;  // plastic_strain_eq (output), softening_strain (state)
 };
 
 LOAM_REGISTER(Material, StrainSofteningMC)

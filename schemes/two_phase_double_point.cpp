@@ -75,7 +75,7 @@
 #include <memory>
 
 #include "framework/affine_transfer.hpp"
-#include "framework/cell_sums.hpp"
+#include "framework/cell_projection.hpp"
 #include "framework/drag.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
@@ -104,9 +104,11 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         .above(0)
         .below(1);
     s.choice("pressure_smoothing", {"cell", "none"},
-             "cell: after every step the liquid points of a grid cell take the cell's mean "
-             "water density (one pressure per cell; removes the point-to-point pressure "
-             "checkerboard); none: every liquid point keeps its own")
+             "cell: after every step the water density is projected per grid cell onto the "
+             "pressure space stable with the shape function: the cell's mean (one pressure per "
+             "cell: linear, gimp, cpdi) or its volume-weighted linear fit (bspline2, whose "
+             "gradients vary inside a cell); removes the point-to-point pressure checkerboard; "
+             "none: every liquid point keeps its own")
         .def("cell");
     s.real("max_porosity", "-",
            "fluidisation threshold n_max (seed 003: 0.5): a solid point whose porosity reaches "
@@ -301,9 +303,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   std::vector<double> cell_liquid_;  // per grid cell: liquid volume sum V at the step's start
   std::vector<size_t> liquid_cell_;  // per liquid point: its cell at the step's start
   double inv_cell_volume_ = 1;
-  std::vector<double> lw_;          // per liquid point: L_w (D * D values) until its stress update
-  std::vector<double> cell_;        // per grid cell: liquid mass and volume (pressure_smoothing)
-  std::vector<size_t> cell_index_;  // each liquid point's cell
+  std::vector<double> lw_;   // per liquid point: L_w (D * D values) until its stress update
+  CellProjection<D> cells_;  // per grid cell: liquid volume and mass, the density's projection
   bool smooth_ = true;
   double n_max_;  // fluidisation threshold (2: never)
   int contact_ = -1, free_surface_ = -1;
@@ -387,25 +388,12 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   /// Per cell the liquid points' volume sum V at the start of the step, and each liquid point's
   /// cell (liquid_cell_, indexed by point). A point's cell lies in its stencil: the scatter's
   /// colouring keeps the sums race-free.
+  /// In point order (framework/cell_sums.hpp): bitwise the same at any thread count.
   void liquid_cell_volumes(Simulation<D>& sim) {
-    liquid_cell_sums(sim, liquid_cell_, cell_liquid_, false);
-  }
-  /// Per grid cell the liquid points' volume sum (with_mass: mass then volume, 2 values) and
-  /// each point's cell, in point order (framework/cell_sums.hpp: bitwise the same at any thread
-  /// count).
-  void liquid_cell_sums(Simulation<D>& sim, std::vector<size_t>& index, std::vector<double>& sums,
-                        bool with_mass) const {
     const Particles<D>& P = sim.sets[kLiquid].particles;
-    const double* m = P.col(P.mass);
     const double* V = P.col(P.volume);
-    if (with_mass)
-      sum_per_cell<2>(sim.grid, P, sim.threads, index, sums, [&](size_t i, double* v) {
-        v[0] = m[i];
-        v[1] = V[i];
-      });
-    else
-      sum_per_cell<1>(sim.grid, P, sim.threads, index, sums,
-                      [&](size_t i, double* v) { v[0] = V[i]; });
+    sum_per_cell<1>(sim.grid, P, sim.threads, liquid_cell_, cell_liquid_,
+                    [&](size_t i, double* v) { v[0] = V[i]; });
   }
 
   template <int NPP>
@@ -924,14 +912,17 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     }
   }
 
-  /// After the move, per grid cell: the liquid points' mass and volume sums, then
-  /// - pressure_smoothing: cell: every liquid point of a cell takes the cell's mean water
-  ///   density, sum m / sum V (V <- m / rho_cell; mass and the cell's water volume are kept), so
-  ///   the fluid's pressure is one per cell. Without it two points of a cell can carry opposite
-  ///   pressures that exert no nodal force, and the storage equation feeds them: the Terzaghi
-  ///   column's top cell reached +-7e5 Pa under a 1e4 Pa load. The single-point scheme does the
-  ///   same with its pore pressure (the Q1-P0 element; Anura3D smooths the liquid pressure per
-  ///   element too).
+  /// After the move, per grid cell: the liquid points' volume and mass sums, then
+  /// - pressure_smoothing: cell: the water density m / V is projected per cell onto the shape
+  ///   function's pressure space (framework/cell_projection.hpp), V <- m / rho_projected: the
+  ///   cell's mean density sum m / sum V (linear, gimp, cpdi; mass and the cell's water volume
+  ///   are kept), so the fluid's pressure is one per cell, or the volume-weighted linear fit of
+  ///   the density (bspline2: a constant per cell is not in equilibrium with the weight where a
+  ///   free surface cuts the B-splines, and the water accelerated without bound). Without it two
+  ///   points of a cell can carry opposite pressures that exert no nodal force, and the storage
+  ///   equation feeds them: the Terzaghi column's top cell reached +-7e5 Pa under a 1e4 Pa load.
+  ///   The single-point scheme does the same with its pore pressure (the Q1-P0 element; Anura3D
+  ///   smooths the liquid pressure per element too).
   /// - free surface: a cell whose pores the water fills less than free_surface_filling (its
   ///   volume sum V over n_c V_c, n_c the cell's porosity from the solid points) is at the free
   ///   surface; its liquid points get the flag and, with free_surface_pressure: zero, zero
@@ -942,22 +933,27 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   ///   surface: its pressure follows its own density there too.
   void liquid_cells(Simulation<D>& sim) {
     Particles<D>& P = sim.sets[kLiquid].particles;
-    liquid_cell_sums(sim, cell_index_, cell_, true);
-    sim.complete_cells(cell_, 2);  // a cell's points may be on two ranks before migration
     const double* m = P.col(P.mass);
     double* V = P.col(P.volume);
+    const CellPressure degree = smooth_ ? sim.shape->cell_pressure() : CellPressure::kConstant;
+    cells_.fit(sim, P, degree, [&](size_t i, double& w, double& wf) {
+      w = V[i];
+      wf = m[i];
+    });
     const long np = long(P.size());
     double* flag = P.col(free_surface_);
     const double filling = free_filling_;
 #pragma omp parallel for schedule(static) num_threads(sim.threads)
     for (long i = 0; i < np; ++i) {
-      const size_t c = cell_index_[size_t(i)];
-      const bool surface = cell_[2 * c + 1] < filling * cell_porosity(c) / inv_cell_volume_;
+      const size_t c = cells_.cell(size_t(i));
+      const bool surface = cells_.weight(c) < filling * cell_porosity(c) / inv_cell_volume_;
       flag[i] = surface ? 1.0 : 0.0;
       if (surface && zero_surface_pressure_)
         V[i] = m[i] / sim.materials[P.material[size_t(i)]]->density();
+      else if (smooth_ && degree == CellPressure::kConstant)
+        V[i] = m[i] * cells_.weight(c) / cells_.weighted_value(c);
       else if (smooth_)
-        V[i] = m[i] * cell_[2 * c + 1] / cell_[2 * c];
+        V[i] = m[i] / cells_.at(sim.grid, P, size_t(i));
     }
   }
 

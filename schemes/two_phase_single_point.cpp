@@ -44,9 +44,11 @@
 //      conserved, so n <- 1 - (1 - n)/J; p <- p - dt K_w/n [ (1 - n) tr L_s + n tr L_w ] (storage
 //      equation, eq. 15) and the material updates sigma' with L_s (Jaumann rate), one call per
 //      block.
-//   5. pressure_smoothing: cell (default): every particle of a grid cell takes the cell's
-//      volume-weighted mean pore pressure (see apply_pressure_increment: without it the
-//      pressure checkerboards once particles cross cells).
+//   5. pressure_smoothing: cell (default): the pore pressure is projected per grid cell onto
+//      the pressure space stable with the shape function (framework/cell_projection.hpp): the
+//      cell's volume-weighted mean (linear, gimp, cpdi) or its linear fit (bspline2); see
+//      apply_pressure_increment: without it the pressure checkerboards once particles cross
+//      cells.
 // Time step: the CFL limit with the fastest wave of the drag-free two-phase equations (the
 // largest eigenvalue of the phases' 2x2 stiffness-mass problem, fast_wave_speed2) and the water
 // wave speed sqrt(K_w/rho_w); no drag limit (implicit drag).
@@ -60,7 +62,7 @@
 #include <memory>
 
 #include "framework/affine_transfer.hpp"
-#include "framework/cell_sums.hpp"
+#include "framework/cell_projection.hpp"
 #include "framework/drag.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
@@ -93,10 +95,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
              "the updated grid velocities directly (one pass less)")
         .def("musl");
     s.choice("pressure_smoothing", {"cell", "none"},
-             "cell: after every step each particle of a grid cell takes the cell's "
-             "volume-weighted mean pore pressure (one pressure per cell; removes the "
-             "particle-to-particle pressure checkerboard that appears once particles cross "
-             "cells); none: every particle keeps its own pressure")
+             "cell: after every step the pore pressure is projected per grid cell onto the "
+             "pressure space stable with the shape function: the cell's volume-weighted mean "
+             "(linear, gimp, cpdi) or its volume-weighted linear fit (bspline2, whose "
+             "gradients vary inside a cell); removes the particle-to-particle pressure "
+             "checkerboard that appears once particles cross cells; none: every particle keeps "
+             "its own pressure")
         .def("cell");
     add_transfer_params(s, "; gimp, bspline2 or cpdi");
     return s;
@@ -129,7 +133,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     p_ = sim.request_field(
         {"pore_pressure", 1, "Pa", "excess pore water pressure, compression positive", {}});
     // One set, the mixture's points (the default declaration): the per-particle scratch below
-    // (dp_, move_, cell_index_) is indexed by its particles.
+    // (dp_, move_, the cell projection) is indexed by its particles.
     auto& P = sim.sets[0].particles;
     rho_w_ = drag_->water_density();
     initialize_particles(sim, sim.sets[0], 0, P.size());
@@ -137,7 +141,6 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     node_.assign(sim.grid.num_nodes * S, 0.0);
     solved_.assign(sim.grid.num_nodes * 2 * D, 0.0);
     dp_.assign(P.size(), 0.0);
-    if (smooth_) cell_.assign(sim.grid.num_cells * 2, 0.0);
     if (musl_) remap_.assign(sim.grid.num_nodes * 2 * D, 0.0);
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
@@ -294,8 +297,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   std::vector<double> mixture_momentum_;  // per node (D values), once damping is on
   // Pore-pressure increments of the step and, per grid cell, the volume-weighted sum of the
   // updated pressures and the volume (pressure_smoothing: cell).
-  std::vector<double> dp_, cell_;
-  std::vector<size_t> cell_index_;  // each particle's cell, from the first pass
+  std::vector<double> dp_;
+  CellProjection<D> cells_;  // the pore pressure per cell (pressure_smoothing: cell)
   bool smooth_ = true;
   struct Scratch : BlockScratch<D> {
     std::vector<double> Q;   // drag coefficients of the block
@@ -304,15 +307,17 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   std::vector<std::unique_ptr<Scratch>> scratch_;
 
   /// Add the storage-equation increments dp_ to the particles' pore pressure and, with
-  /// pressure_smoothing: cell, give every particle of a grid cell the cell's volume-weighted
-  /// mean. Without it the pressure field has one degree of freedom per particle against one
-  /// velocity per node: a pressure alternating from particle to particle exerts (nearly) no
-  /// nodal force, so nothing restrains it, and once particles cross cells the storage equation
-  /// feeds it (soft column of issue 6: +-2 MPa under a 50 kPa load, then the porosity leaves
-  /// (0, 1)). One pressure per cell is the constant-pressure (Q1-P0) element of mixed finite
-  /// elements and the element-wise liquid-pressure smoothing of the Anura3D v-w code; it
-  /// conserves the volume integral of p in each cell. Averaging only the increments is not
-  /// enough: the checkerboard left by particles that change cells stays frozen (+-9 kPa).
+  /// pressure_smoothing: cell, project it per grid cell onto the shape function's pressure
+  /// space (the volume-weighted mean, or the linear fit for B-splines). Without it the pressure
+  /// field has one degree of freedom per particle against one velocity per node: a pressure
+  /// alternating from particle to particle exerts (nearly) no nodal force, so nothing restrains it,
+  /// and once particles cross cells the storage equation feeds it (soft column of issue 6: +-2 MPa
+  /// under a 50 kPa load, then the porosity leaves (0, 1)). One pressure per cell is the
+  /// constant-pressure (Q1-P0) element of mixed finite elements and the element-wise
+  /// liquid-pressure smoothing of the Anura3D v-w code; it conserves the volume integral of p in
+  /// each cell. With B-splines it is not in equilibrium with the weight where a free surface cuts
+  /// their support (framework/cell_projection.hpp). Averaging only the increments is not enough:
+  /// the checkerboard left by particles that change cells stays frozen (+-9 kPa).
   void apply_pressure_increment(Simulation<D>& sim) {
     Particles<D>& P = sim.sets[0].particles;
     const long np = long(P.size());
@@ -323,16 +328,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       return;
     }
     const double* V = P.col(P.volume);
-    sum_per_cell<2>(sim.grid, P, sim.threads, cell_index_, cell_, [&](size_t i, double* v) {
-      v[0] = V[i] * (p[i] + dp_[i]);
-      v[1] = V[i];
+    cells_.fit(sim, P, sim.shape->cell_pressure(), [&](size_t i, double& w, double& wf) {
+      w = V[i];
+      wf = V[i] * (p[i] + dp_[i]);
     });
-    sim.complete_cells(cell_, 2);  // a cell's particles may be on two ranks before migration
 #pragma omp parallel for schedule(static) num_threads(sim.threads)
-    for (long i = 0; i < np; ++i) {
-      const size_t c = cell_index_[size_t(i)];
-      p[i] = cell_[2 * c] / cell_[2 * c + 1];
-    }
+    for (long i = 0; i < np; ++i) p[i] = cells_.at(sim.grid, P, size_t(i));
   }
 
   /// Block b's stencil evaluated (with the affine geometry when `affine`) and kernel(form)

@@ -44,6 +44,8 @@ class BSpline2 : public ShapeFunction<D> {
   explicit BSpline2(const Params&) {}
 
   int nodes_per_particle() const override { return ipow(3, D); }
+  /// Gradients linear inside a cell: the stable pressure per cell is linear (Q2-P1disc).
+  CellPressure cell_pressure() const override { return CellPressure::kLinear; }
   // Nearest node b is r or r+1 for a particle in cell row r; nodes b-1 .. b+1.
   int rows_below() const override { return 1; }
   int rows_above() const override { return 2; }

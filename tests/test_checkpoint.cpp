@@ -292,3 +292,45 @@ TEST_CASE(
                " --set stages.0.static_speed=1e-4 --set stages.1.static_speed=1e-4",
                500, 5000);
 }
+
+TEST_CASE("Ctrl-C on the default scene without output.checkpoint resumes to the same final frame",
+          "[checkpoint][interrupt]") {
+  // A run interrupted by SIGINT always writes a checkpoint (one file, also without
+  // output.checkpoint); `--resume DIR` finishes the run, and its final frame is bitwise that of
+  // the run never interrupted; the resumed run, not asked to keep checkpoints, removes it.
+  loam_test::TempDir a("ckpt_ctrl_c_a"), b("ckpt_ctrl_c_b");
+  const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/granular_collapse_2d.yaml";
+  const std::string args = " --quiet --threads 1";
+  REQUIRE(loam_test::run_loam("run " + cfg + " --out " + a.path.string() + args).exit_code == 0);
+  const int code = loam_test::run_bash(
+      std::string(LOAM_EXE) + " run " + cfg + " --out " + b.path.string() + args +
+      " & pid=$!; while [ ! -e " + (b.path / "particles_000002.h5").string() +
+      " ] && kill -0 $pid 2>/dev/null; do sleep 0.01; done; kill -INT $pid; wait $pid");
+  REQUIRE(code == 130);
+  long checkpoints = 0;
+  for (const auto& e : fs::directory_iterator(b.path))
+    checkpoints += e.path().filename().string().rfind("checkpoint_", 0) == 0;
+  auto interrupted = nlohmann::json::parse(loam_test::slurp(b.path / "summary.json"));
+  std::printf("granular collapse interrupted at step %ld: %ld checkpoint file(s); resuming\n",
+              interrupted["steps"].get<long>(), checkpoints);
+  CHECK(checkpoints == 1);
+  auto r = loam_test::run_loam("run " + cfg + " --resume " + b.path.string() + args);
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  auto sa = nlohmann::json::parse(loam_test::slurp(a.path / "summary.json"));
+  auto sb = nlohmann::json::parse(loam_test::slurp(b.path / "summary.json"));
+  CHECK(sb["status"] == "ok");
+  CHECK(sa["steps"] == sb["steps"]);
+  CHECK(sa["verify"] == sb["verify"]);
+  const long fa = sa["frames"], fb = sb["frames"];
+  char last_a[64], last_b[64];
+  std::snprintf(last_a, sizeof last_a, "particles_%06ld.h5", fa - 1);
+  std::snprintf(last_b, sizeof last_b, "particles_%06ld.h5", fb - 1);
+  for (const char* field : {"position", "velocity", "stress", "plastic_strain_eq"})
+    CHECK(loam_test::read_frame_doubles(a.path / last_a, field) ==
+          loam_test::read_frame_doubles(b.path / last_b, field));
+  long left = 0;
+  for (const auto& e : fs::directory_iterator(b.path))
+    left += e.path().filename().string().rfind("checkpoint_", 0) == 0;
+  CHECK(left == 0);
+}

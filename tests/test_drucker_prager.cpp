@@ -112,18 +112,18 @@ TEST_CASE("drucker_prager: the cone's three matchings give their documented stre
           "[material][unit][drucker_prager]") {
   // The cone constants of each matching at phi = 30 deg (de Souza Neto, Peric & Owen 2008,
   // section 6.4.6; the material's header): compression eta = 0.3849, xi = 1.1547; extension
-  // 0.2962, 0.8885; plane strain 0.2774, 0.9608. Pure shear from a stress-free state (psi = 0,
-  // so p stays 0) must end at sqrt(J2) = xi c, an isotropic extension at the apex xi c / eta:
-  // both to 1e-10.
+  // 0.2962, 0.8885; plane strain with psi = 0 sin phi, cos phi (0.5, 0.8660). Pure shear from a
+  // stress-free state (psi = 0, so p stays 0) must end at sqrt(J2) = xi c, an isotropic extension
+  // at the apex xi c / eta: both to 1e-10.
   struct Case {
     const char* match;
     double eta, xi;
   };
-  const double s = 0.5, c = std::sqrt(3.0) / 2, t = std::tan(rad(30));
+  const double s = 0.5, c = std::sqrt(3.0) / 2;
   const Case cases[] = {
       {"compression", 6 * s / (std::sqrt(3.0) * (3 - s)), 6 * c / (std::sqrt(3.0) * (3 - s))},
       {"extension", 6 * s / (std::sqrt(3.0) * (3 + s)), 6 * c / (std::sqrt(3.0) * (3 + s))},
-      {"plane_strain", 3 * t / std::sqrt(9 + 12 * t * t), 3 / std::sqrt(9 + 12 * t * t)}};
+      {"plane_strain", s, c}};
   for (const auto& k : cases) {
     // Pure shear at p = 0 from a stress-free state: the shear strength sqrt(J2) = xi c; an
     // isotropic extension ends at the apex p = xi c / eta.
@@ -274,4 +274,34 @@ TEST_CASE("drucker_prager through loam element-test: the drained triaxial of its
               dv / da, dil);
   CHECK(peak == Approx(200e3).epsilon(1e-6));
   CHECK(dv / da == Approx(dil).epsilon(1e-6));
+}
+
+TEST_CASE(
+    "drucker_prager: plane_strain matching gives Mohr-Coulomb's simple-shear strength at "
+    "psi = 0",
+    "[material][unit][drucker_prager]") {
+  // Reference: the plane-strain limit state (materials/drucker_prager.cpp header): with the cone
+  // matched for the given psi, f = 0 at zero out-of-plane plastic strain rate is Mohr-Coulomb's
+  // t = c cos phi - s_m sin phi. Simple shear (L_xy only, plane strain) from an isotropic 100
+  // kPa, c = 0, phi = 30 deg, to gamma = 0.1: the ratio tau_xy / -sigma_yy of drucker_prager
+  // must equal mohr_coulomb's within 1e-3 (tending to sin phi = 0.5, Davis 1968). The cone
+  // matched as if associated gave 0.4799. With psi > 0 this isochoric path has no limit state
+  // (the dilation keeps raising the mean stress), so it cannot check those.
+  for (double psi : {0.0}) {
+    const std::string params = ", nu: " + std::to_string(kNu) +
+                               ", density: 2000, c: 0, phi: 30, psi: " + std::to_string(psi);
+    loam_test::MaterialPoint<3> dp("{type: drucker_prager, E: " + std::to_string(kE) + params +
+                                   ", match: plane_strain}");
+    loam_test::MaterialPoint<3> mc("{type: mohr_coulomb, E: " + std::to_string(kE) + params + "}");
+    for (auto* pt : {&dp, &mc}) {
+      pt->isotropic(-100e3);
+      for (int i = 0; i < 1000; ++i) pt->step({0, 1e-4, 0, 0, 0, 0, 0, 0, 0});
+    }
+    const double r_dp = dp.stress(3) / -dp.stress(1), r_mc = mc.stress(3) / -mc.stress(1);
+    std::printf(
+        "simple shear phi 30 psi %.0f: tau/sigma_n drucker_prager plane_strain %.5f, "
+        "mohr_coulomb %.5f\n",
+        psi, r_dp, r_mc);
+    CHECK(std::fabs(r_dp / r_mc - 1) <= 1e-3);
+  }
 }

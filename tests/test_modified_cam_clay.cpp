@@ -536,3 +536,39 @@ TEST_CASE("modified_cam_clay: bad parameters give the located error", "[material
   };
   loam_test::check_bad_material("type: modified_cam_clay, e0: 1, ocr: 1, density: 1800, ", cases);
 }
+
+TEST_CASE("modified_cam_clay: strength reduction divides tan phi_cs by F and keeps the state",
+          "[material][unit]") {
+  // Reference: docs/strength_reduction.md (Wood 1990): sin phi_cs = 3M / (6 + M), tan phi_F =
+  // tan phi_cs / F, M_F = 6 sin phi_F / (3 - sin phi_F); M = 1.2 (phi_cs = 30 deg) at F = 1.25
+  // gives M_F = 0.97489. The reduced model must follow the path of a model made with M_F from
+  // the same state (stresses within 1e-9 relative over 400 steps of pure shear from p' = 100
+  // kPa, pc = 200 kPa: the top of the ellipse), and end on q / p' = M_F within 1e-3.
+  const double F = 1.25, s = 3 * kM / (6 + kM);
+  const double sf = std::sin(std::atan(std::tan(std::asin(s)) / F));
+  const double MF = 6 * sf / (3 - sf);
+  char m_f[64];
+  std::snprintf(m_f, sizeof m_f, "M: %.17g", MF);
+  std::string with_mf = mcc(", ocr: 2");
+  with_mf.replace(with_mf.find("M: 1.2"), 6, m_f);
+  Point<3> a(mcc(", ocr: 2")), b(with_mf);
+  for (auto* pt : {&a, &b}) pt->set({-kP0, -kP0, -kP0, 0, 0, 0});
+  REQUIRE(a.pc() == Approx(2 * kP0));
+  auto reduced = a.sim->materials[0]->reduced(F);
+  REQUIRE(reduced);
+  a.sim->materials[0] = std::move(reduced);
+  double worst = 0;
+  for (int i = 0; i < 400; ++i) {
+    const std::vector<double> l = {1e-4, 0, 0, 0, -0.5e-4, 0, 0, 0, -0.5e-4};
+    a.step(l);
+    b.step(l);
+    for (int k = 0; k < 6; ++k) worst = std::max(worst, std::fabs(a.stress(k) - b.stress(k)) / kP0);
+  }
+  std::printf(
+      "MCC reduced by F = %.2f: M_F %.5f, q/p' %.5f at the end, max |sigma - sigma(M_F)| "
+      "/ p'0 %.2e\n",
+      F, MF, a.q() / a.p(), worst);
+  CHECK(MF == Approx(0.97489).margin(5e-5));
+  CHECK(worst <= 1e-9);
+  CHECK(std::fabs(a.q() / a.p() / MF - 1) <= 1e-3);
+}
