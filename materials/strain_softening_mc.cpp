@@ -36,15 +36,19 @@
 // Very brittle softening (a drop of strength over a strain range that is small against the
 // strength over the elastic modulus) gives a local snap-back, where r(x) may have several
 // roots; the solve then returns one bracketed root (after 60 returns, the last iterate).
-// Regularisation (optional `characteristic_length` l_c): a softening band localises into about
-// one particle (or cell) width, so the strain range over which the strength falls, and with it
-// the energy dissipated in the band, shrinks with the resolution. With l_c the softening
-// strains are given for a band of width l_c and scaled to the particle size l_p of the body
-// (l_p = V_p^(1/D) at set-up, the lattice spacing), softening_start l_c / l_p and
-// softening_end l_c / l_p: the displacement across the band over which the strength falls,
+// Regularisation (optional `characteristic_length` l_c): a softening band localises into the
+// narrowest band the grid resolves, so the strain range over which the strength falls, and with
+// it the energy dissipated in the band, shrinks with the resolution. That width is the cell, not
+// the particle spacing: a particle's velocity gradient comes from the nodes of its cell (constant
+// over the cell for linear tents, nearly so for GIMP), so the points of one cell strain alike and
+// a band cannot be narrower than h, however many points a cell holds. With l_c the softening
+// strains are given for a band of width l_c and scaled to the band width w = h of the grid
+// (h = (h_1 ... h_D)^(1/D), the geometric mean of the cell sides): softening_start l_c / h and
+// softening_end l_c / h. The displacement across the band over which the strength falls,
 // (softening_end - softening_start) l_c, and the fracture energy per unit band area are then
-// independent of the resolution (Pietruszczak & Mroz 1981, the crack-band idea of Bazant &
-// Oh 1983). Without it the strains apply as given at every resolution (mesh-dependent).
+// independent of the resolution: the crack band of Bazant & Oh (1983), whose width is one
+// element (Pietruszczak & Mroz 1981). Without it the strains apply as given at every resolution
+// (mesh-dependent).
 #include <cmath>
 #include <limits>
 #include <string>
@@ -98,9 +102,10 @@ class StrainSofteningMC : public Material<D> {
            "c/tan(phi); default: the apex")
         .non_negative();
     s.real("characteristic_length", "m",
-           "regularisation: the softening strains hold for a band this wide; each body scales "
-           "them by characteristic_length / (its particle size), so the displacement over which "
-           "a band softens does not depend on the resolution (default: no scaling)")
+           "regularisation: the softening strains hold for a band this wide; they are scaled by "
+           "characteristic_length / h, h the grid's cell size (the narrowest band it resolves; "
+           "the geometric mean of the sides), so the displacement over which a band softens does "
+           "not depend on the cell size or the particles per cell (default: no scaling)")
         .positive();
     s.check([](const Params& p, Diagnostics& d) {
       auto fmt = [&](const char* k) { return std::string(k) + " = " + format_number(p.real(k)); };
@@ -159,7 +164,7 @@ class StrainSofteningMC : public Material<D> {
     scale_ = 1;
     if (length_ > 0) {
       double volume = 1;
-      for (double h : sim.bodies[size_t(m)].spacing) volume *= h;
+      for (double h : sim.grid.cell) volume *= h;
       scale_ = length_ / std::pow(volume, 1.0 / D);
     }
   }
@@ -247,7 +252,7 @@ class StrainSofteningMC : public Material<D> {
   double E_, nu_, rho_;
   double c_[2], phi_[2], psi_[2];  // peak, residual
   double start_, end_, cutoff_;
-  double length_ = 0, scale_ = 1;  // characteristic_length (0: none), l_c / l_p
+  double length_ = 0, scale_ = 1;  // characteristic_length (0: none), l_c / h
   double G_ = 0, lambda_ = 0, M_ = 0;
   bool constant_ = false;
   int eq_ = -1, state_ = -1;  // plastic_strain_eq (output), softening_strain (state)

@@ -163,7 +163,7 @@ TEST_CASE(
         "below ground (plastic_strain_eq %.3f)\n",
         a, a + 4, depth, eps[best]);
     shallowest = std::min(shallowest, depth), deepest = std::max(deepest, depth);
-    // Softening under way: the strains soften over 0.15 l_c / l_p = 0.3 for the 1 m particles.
+    // Softening under way: the strains soften over 0.15 l_c / h = 0.3 on the 2 m cells.
     CHECK(eps[best] > 0.1);
   }
   std::printf(

@@ -37,11 +37,14 @@ struct Curve {
 /// 25 deg over eps_q^p 0 -> 0.05, weak corner (c_peak 15 kPa) 0.2 m square at the base's right end.
 /// Axial load: the volume mean of -sigma_yy times the width (static equilibrium: int sigma_yy dV =
 /// H F).
-Curve biaxial(double h, const std::string& regularisation) {
+Curve biaxial(double h, const std::string& regularisation, int ppc = 2,
+              double softening_end = 0.05) {
+  char end[32];
+  std::snprintf(end, sizeof end, "%g", softening_end);
   const std::string soft =
       "E: 2.0e7, nu: 0.3, density: 2000, c_residual: 2000, phi_peak: 30, phi_residual: 25, "
-      "psi_peak: 0, psi_residual: 0, softening_end: 0.05" +
-      regularisation;
+      "psi_peak: 0, psi_residual: 0, softening_end: " +
+      std::string(end) + regularisation;
   const std::string stress = "stress: [-5.0e4, -5.0e4, -5.0e4, 0]\n";
   auto sim = loam_test::make_simulation<2>(
       "grid: {extent: [1.5, 2.5], cell_size: " + std::to_string(h) +
@@ -52,6 +55,9 @@ Curve biaxial(double h, const std::string& regularisation) {
           "  - name: soil\n"
           "    generator: {type: difference, of: {type: box, min: [0, 0], max: [1, 2]}, minus: "
           "[{type: box, min: [0.8, 0], max: [1, 0.2]}]}\n"
+          "    particles_per_cell: " +
+          std::to_string(ppc) +
+          "\n"
           "    material: {type: strain_softening_mc, c_peak: 20000, " +
           soft +
           "}\n"
@@ -59,6 +65,9 @@ Curve biaxial(double h, const std::string& regularisation) {
           stress +
           "  - name: weak\n"
           "    generator: {type: box, min: [0.8, 0], max: [1, 0.2]}\n"
+          "    particles_per_cell: " +
+          std::to_string(ppc) +
+          "\n"
           "    material: {type: strain_softening_mc, c_peak: 15000, " +
           soft +
           "}\n"
@@ -99,21 +108,21 @@ TEST_CASE(
     "strain softening: with characteristic_length the post-peak load hardly depends on "
     "the cell size",
     "[material][regularisation][verification]") {
-  // Cells 0.1 and 0.05 m (particles 0.05 and 0.025 m); l_c = 0.05 m (scale 1 on the coarse
-  // grid, 2 on the fine one). Printed: the load against the platen travel, the peak (the
+  // Cells 0.1 and 0.05 m (particles 0.05 and 0.025 m); l_c = 0.1 m (scale l_c / h: 1 on the
+  // coarse grid, 2 on the fine one). Printed: the load against the platen travel, the peak (the
   // failure load) and the load 4 mm of travel after the coarse run's peak, in the middle of
   // the softening. Targets: with l_c the failure load changes by less than 10 % between the
   // resolutions (the criterion), and the post-peak load changes less with l_c than
   // without (measured 2026-12-04: peak -1.9 % without, +5.3 % with; 0.019 m of travel, -16.2 %
   // without, +6.9 % with).
   const double coarse = 0.1, fine = 0.05;
-  const std::string reg = ", characteristic_length: 0.05";
+  const std::string reg = ", characteristic_length: 0.1";
   const Curve a = biaxial(coarse, ""), b = biaxial(fine, ""), c = biaxial(coarse, reg),
               d = biaxial(fine, reg);
   for (size_t k = 0; k < a.travel.size(); k += 4)
     std::printf(
         "biaxial softening: travel %.4f m, load %6.1f kN/m (0.1 m cells), %6.1f (0.05 m) "
-        "without l_c; %6.1f, %6.1f with l_c = 0.05 m\n",
+        "without l_c; %6.1f, %6.1f with l_c = 0.1 m\n",
         a.travel[k], a.load[k] / 1e3, b.at(a.travel[k]) / 1e3, c.at(a.travel[k]) / 1e3,
         d.at(a.travel[k]) / 1e3);
   const double u_peak =
@@ -130,4 +139,34 @@ TEST_CASE(
       d.at(u) / 1e3, 100 * post_with);
   CHECK(std::fabs(peak_with) < 0.10);
   CHECK(std::fabs(post_with) < std::fabs(post_without));
+}
+
+TEST_CASE(
+    "strain softening: characteristic_length scales by the cell, whatever the points per cell",
+    "[material][regularisation][verification]") {
+  // The band a grid resolves is a cell wide, so the regularisation must not depend on how many
+  // points a cell holds: with l_c = 0.05 m on 0.1 m cells (scale 0.5) the run is bitwise the
+  // unregularised run with softening_end 0.025, at 2 and at 4 points per cell and axis. Scaled
+  // by the particle spacing instead (0.05 and 0.025 m) l_c doubled the softening strains from
+  // 2 to 4 points per cell: the load at 2.6 s was 112.4 / 127.9 / 142.0 kN/m at 2 / 3 / 4
+  // points (+26 %), against 112.4 / 121.7 / 124.8 without l_c. Printed: the spread left, which
+  // is the points' own (the band forms over the points of a cell either way).
+  const std::string reg = ", characteristic_length: 0.05";
+  std::vector<Curve> with;
+  for (int ppc : {2, 3, 4}) {
+    with.push_back(biaxial(0.1, reg, ppc));
+    if (ppc == 3) continue;
+    const Curve c = biaxial(0.1, "", ppc, 0.025);
+    CHECK(c.load == with.back().load);
+  }
+  for (size_t k = 0; k < with.size(); ++k)
+    std::printf(
+        "biaxial softening, l_c = 0.05 m on 0.1 m cells, %zu points per cell: peak %.1f "
+        "kN/m, %.1f at 0.03 m of travel, %.1f at 2.6 s (0.05 m)\n",
+        k + 2, with[k].peak() / 1e3, with[k].at(0.03) / 1e3, with[k].load.back() / 1e3);
+  std::printf(
+      "biaxial softening, 2 -> 4 points per cell with l_c: peak %+.1f %%, at 0.03 m "
+      "%+.1f %%, at 2.6 s %+.1f %%\n",
+      100 * (with[2].peak() / with[0].peak() - 1), 100 * (with[2].at(0.03) / with[0].at(0.03) - 1),
+      100 * (with[2].load.back() / with[0].load.back() - 1));
 }

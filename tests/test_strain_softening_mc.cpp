@@ -388,13 +388,13 @@ TEST_CASE("strain_softening_mc: bad parameters give the located error", "[materi
   loam_test::check_bad_material("type: strain_softening_mc, density: 2000, ", cases);
 }
 
-TEST_CASE("strain_softening_mc: characteristic_length scales the softening strains by l_c / l_p",
+TEST_CASE("strain_softening_mc: characteristic_length scales the softening strains by l_c / h",
           "[material][unit][regularisation]") {
-  // Regularisation (issue 16, deliverable 5): with characteristic_length l_c the softening
-  // strains apply to a band l_c wide and are scaled by l_c / l_p, l_p = V_p^(1/D) the body's
-  // particle size (here the one-point config's lattice: cell 0.25 m, 2 per cell, l_p = 0.125 m).
-  //  - l_c = l_p: scale 1, bitwise the unregularised response;
-  //  - l_c = 2 l_p: bitwise the response with softening_start and softening_end doubled
+  // Regularisation: with characteristic_length l_c the softening strains apply to a band l_c
+  // wide and are scaled by l_c / h, h the grid's cell size, the narrowest band it resolves
+  // (here the one-point config's 0.25 m cells, 2 points per cell).
+  //  - l_c = h: scale 1, bitwise the unregularised response;
+  //  - l_c = 2 h: bitwise the response with softening_start and softening_end doubled
   //    (0.01 -> 0.02, 0.05 -> 0.10: the products are exact in binary).
   // Plane strain drained compression at 100 kPa to 15 % axial strain, 1500 increments.
   auto run = [](const Soft& m) {
@@ -403,9 +403,9 @@ TEST_CASE("strain_softening_mc: characteristic_length scales the softening strai
   };
   Soft plain;
   Soft same = plain;
-  same.extra = ", characteristic_length: 0.125";
+  same.extra = ", characteristic_length: 0.25";
   Soft twice = plain;
-  twice.extra = ", characteristic_length: 0.25";
+  twice.extra = ", characteristic_length: 0.5";
   Soft stretched = plain;
   stretched.start = 0.02;
   stretched.end = 0.10;
@@ -422,9 +422,9 @@ TEST_CASE("strain_softening_mc: characteristic_length scales the softening strai
     if (std::isnan(eq_c) && c[i].eq >= stretched.end) eq_c = c[i].eq;
   }
   std::printf(
-      "characteristic_length: l_c = l_p bitwise the plain response: %s; l_c = 2 l_p "
+      "characteristic_length: l_c = h bitwise the plain response: %s; l_c = 2 h "
       "bitwise softening strains x 2: %s; residual reached at eq %.4f (plain) and %.4f "
-      "(l_c = 2 l_p)\n",
+      "(l_c = 2 h)\n",
       ab ? "yes" : "no", cd ? "yes" : "no", eq_a, eq_c);
   CHECK(ab);
   CHECK(cd);
