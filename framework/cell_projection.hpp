@@ -21,11 +21,12 @@
 // centre in cell units, ybar and fbar the weighted means, C the weighted covariance of y and c
 // that of y and f, f(y) = fbar + b . (y - ybar), (C + eps I) b = c. eps = kRegularisation
 // keeps the slope finite where the particles of a cell lie on one line or at one point (C
-// singular) and makes the fit a continuous function of the sums. C comes from sums (sum w y y
-// / W - ybar^2), so its round-off is about 1e-16 in absolute terms, and a direction of variance
-// var carries it into the fitted values as 1e-16 / (var + eps) of the cell's variation of f:
-// eps = 1e-8 keeps the sums of another rank count within round-off of the field, and takes
-// 1.2e-7 of the slope of evenly spread points (var = 1/12) per projection.
+// singular) and makes the fit a continuous function of the sums. C and c come from sums (sum w
+// y y / W - ybar^2, sum w f y / W - fbar ybar), so their round-off is about 1e-16 and 1e-16
+// |fbar| in absolute terms, and a direction of variance var carries it into the fitted values
+// as about 1e-16 |fbar| sqrt(var) / (var + eps), at most 5e-13 |fbar| with eps = 1e-8: the sums
+// of another rank count stay near round-off of the field. eps takes 1.2e-7 of the slope of
+// evenly spread points (var = 1/12) per projection.
 // The sums run in particle order (cell_sums.hpp): the same bits at any thread count; under
 // mpirun they are completed over the ranks before the fit.
 #include <omp.h>

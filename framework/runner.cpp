@@ -808,8 +808,16 @@ RunResult Run<D>::loop() {
       if (ls_.frame_step != sim.step) write_frame("");
       sample_probes(true);
       if (ls_.history_step != sim.step) write_history();
-      if (checkpoint_problem().empty()) {
+      // Resumable from inside a stage, as from a periodic checkpoint: the stage's record
+      // ("interrupted") stays out of the image, the resumed run writes the stage's own. Not
+      // from inside the strength reduction: its search would start again from a stage ended.
+      const bool in_search = srf.is_object() && srf.value("status", "") == "interrupted";
+      if (checkpoint_problem().empty() && !in_search) {
+        const nlohmann::json records = stage_records_;
+        if (!records.empty() && records.back()["status"] == "interrupted")
+          stage_records_.erase(stage_records_.size() - 1);
         write_checkpoint(checkpoint_image());
+        stage_records_ = records;
         resumable = true;
       }
     });
@@ -955,7 +963,9 @@ RunResult Run<D>::loop() {
   }
   // A run that was not asked for checkpoints keeps none once it has ended: the one its
   // interruption left was only for --resume.
-  if (files && res.exit_code == 0 && !checkpointing())
+  bool ended = files && res.exit_code == 0;
+  if (distributed) ended = sim.ranks->max(int(!ended)) == 0;  // only the first rank writes summary
+  if (ended && !checkpointing())
     for (const auto& file : checkpoints_) {
       std::error_code ec;
       fs::remove(file, ec);

@@ -44,7 +44,7 @@ void Run<D>::check_strength_reduction(Diagnostics& diag) {
     else
       left_out += (left_out.empty() ? "'" : ", '") + sim.bodies[b].name + "'";
   }
-  if (!left_out.empty() && !srf_bodies_.empty())
+  if (!left_out.empty() && !srf_bodies_.empty() && sim.ranks->root())
     spdlog::warn(
         "strength reduction leaves out {}: no strength to reduce (an elastic or fluid "
         "model after the last stage)",

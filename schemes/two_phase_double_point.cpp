@@ -208,24 +208,30 @@ class TwoPhaseDoublePoint : public Scheme<D> {
                      "framework/affine_transfer.hpp)");
   }
 
-  /// Solid points: porosity n0, solid mass (1 - n0) rho_s V, in contact. Liquid points (a
-  /// source's, during the run): like fill_pores, the fraction n_c of their volume and mass, n_c
-  /// the porosity of their cell from the last step's solid volumes (1 in pure water), so water
-  /// created inside the soil fills only its pores.
+  /// Solid points: porosity n0, solid mass (1 - n0) rho_s V, in contact. Liquid points (at
+  /// set-up, fill_pores, and a source's during the run): the fraction n of their volume and
+  /// mass, n the porosity of the solid point whose domain holds the liquid point and 1 where
+  /// none does (solid_porosity_at), so water generated over the soil fills only its pores, and
+  /// a soil surface inside a cell divides the cell's water by point: the point in the soil keeps
+  /// n rho_w V, the point above it rho_w V.
   void initialize_particles(Simulation<D>& sim, ParticleSet<D>& set, size_t b, size_t e) override {
     auto& P = set.particles;
-    const bool solid = &set == &sim.sets[kSolid];
-    for (size_t i = b; i < e; ++i) {
-      if (solid) {
+    if (&set == &sim.sets[kSolid]) {
+      for (size_t i = b; i < e; ++i) {
         P.col(n_)[i] = n0_;
         P.col(P.mass)[i] *= 1 - n0_;
         P.col(contact_)[i] = 1;
-      } else {
-        const double n = cell_porosity(particle_cell(sim.grid, P, i));
-        P.col(n_)[i] = n;
-        P.col(P.volume)[i] *= n;
-        P.col(P.mass)[i] *= n;
       }
+      return;
+    }
+    const SolidIndex solid = index_solid_points(sim);
+    for (size_t i = b; i < e; ++i) {
+      double x[D];
+      for (int d = 0; d < D; ++d) x[d] = P.col(P.position, d)[i];
+      const double n = solid_porosity_at(sim, solid, x);
+      P.col(n_)[i] = n;
+      P.col(P.volume)[i] *= n;
+      P.col(P.mass)[i] *= n;
     }
   }
 
@@ -352,19 +358,70 @@ class TwoPhaseDoublePoint : public Scheme<D> {
 
   /// The liquid bodies are generated like any body, a point per spacing filling its whole
   /// volume; where they overlap the soil only the pores hold water. At set-up each liquid point
-  /// keeps the fraction n_c of its volume and mass, n_c the porosity of its grid cell
-  /// (cell_porosity): V <- n_c V, m <- n_c m (intrinsic water volume at the material's density).
-  /// A regular fill thus puts exactly the pore volume of each cell in water; pure water keeps
-  /// its points as they are (n_c = 1).
+  /// keeps the fraction n of its volume and mass that the pores around it leave
+  /// (initialize_particles): V <- n V, m <- n m (intrinsic water volume at the material's
+  /// density). A regular fill thus puts exactly the pore volume of the soil in water; pure water
+  /// keeps its points as they are (n = 1).
   void fill_pores(Simulation<D>& sim) {
-    auto& solid = sim.sets[kSolid].particles;
-    auto& liquid = sim.sets[kLiquid].particles;
-    // Also without liquid bodies: the sources at t = 0 re-mass their points with it.
-    cell_solid_.assign(sim.grid.num_cells, 0.0);
-    for (size_t i = 0; i < solid.size(); ++i)
-      cell_solid_[particle_cell(sim.grid, solid, i)] +=
-          (1 - solid.col(n_)[i]) * solid.col(solid.volume)[i];
-    initialize_particles(sim, sim.sets[kLiquid], 0, liquid.size());
+    initialize_particles(sim, sim.sets[kLiquid], 0, sim.sets[kLiquid].size());
+  }
+
+  /// The solid points sorted by grid cell: the points of cell c are order[start[c] ..
+  /// start[c + 1]).
+  struct SolidIndex {
+    std::vector<size_t> start, order;
+  };
+  SolidIndex index_solid_points(const Simulation<D>& sim) const {
+    const Particles<D>& S = sim.sets[kSolid].particles;
+    SolidIndex idx;
+    idx.start.assign(sim.grid.num_cells + 1, 0);
+    std::vector<size_t> cell(S.size());
+    for (size_t j = 0; j < S.size(); ++j)
+      ++idx.start[(cell[j] = particle_cell(sim.grid, S, j)) + 1];
+    for (size_t c = 0; c < sim.grid.num_cells; ++c) idx.start[c + 1] += idx.start[c];
+    idx.order.resize(S.size());
+    std::vector<size_t> next(idx.start.begin(), idx.start.end() - 1);
+    for (size_t j = 0; j < S.size(); ++j) idx.order[next[cell[j]]++] = j;
+    return idx;
+  }
+
+  /// The porosity of the solid point whose domain holds x, 1 if none does. A solid point's
+  /// domain is its lattice box, the body's spacing s_d scaled by (V / prod s_d)^(1/D) as its
+  /// volume changes; the boxes of x's cell and its neighbours are searched (a lattice that is
+  /// not aligned with the cells has boxes across cell faces).
+  double solid_porosity_at(const Simulation<D>& sim, const SolidIndex& idx, const double* x) const {
+    const Particles<D>& S = sim.sets[kSolid].particles;
+    const Grid<D>& g = sim.grid;
+    int lo[D], hi[D], c[D];
+    for (int d = 0; d < D; ++d) {
+      const int k = g.cell_of(x[d], d);
+      lo[d] = std::max(k - 1, 0), hi[d] = std::min(k + 1, g.cells[d] - 1), c[d] = lo[d];
+    }
+    while (true) {
+      size_t cell = 0;
+      for (int d = 0; d < D; ++d) cell += size_t(c[d]) * size_t(g.cell_stride[d]);
+      for (size_t k = idx.start[cell]; k < idx.start[cell + 1]; ++k)
+        if (holds(sim, S, idx.order[k], x)) return S.col(n_)[idx.order[k]];
+      int d = 0;
+      while (d < D && ++c[d] > hi[d]) c[d] = lo[d], ++d;
+      if (d == D) return 1.0;
+    }
+  }
+
+  /// Whether solid point j's domain box holds x. The boxes of a lattice share their faces, and a
+  /// point of another lattice (the water generated with other particles_per_cell) can lie on
+  /// one: a relative tolerance of 1e-9 keeps round-off from leaving it in no box (in two, the
+  /// first found decides; neighbouring solid points have the same porosity at set-up).
+  bool holds(const Simulation<D>& sim, const Particles<D>& S, size_t j, const double* x) const {
+    const auto& s = sim.bodies[S.body[j]].spacing;
+    double lattice = 1;
+    for (int d = 0; d < D; ++d) lattice *= s[size_t(d)];
+    const double stretch = std::pow(S.col(S.volume)[j] / lattice, 1.0 / D);
+    for (int d = 0; d < D; ++d) {
+      const double half = 0.5 * s[size_t(d)] * stretch, r = x[d] - S.col(S.position, d)[j];
+      if (!(std::fabs(r) <= half * (1 + 1e-9))) return false;
+    }
+    return true;
   }
 
   /// Porosity of grid cell c from the solid volume in it, n_c = 1 - V_s,c / V_c in

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <initializer_list>
 
 #include "cli.hpp"
 
@@ -182,6 +183,45 @@ TEST_CASE("an unstable run checkpoints its last good state and resuming it fails
   require_same_outputs(a.path, b.path, 2);
 }
 
+namespace {
+
+/// Run `cfg` (with `args`) into a uninterrupted, then into b with SIGINT once b's frame
+/// `frame` exists and `delay` seconds more: the interrupted run's exit code.
+int run_then_interrupt(const std::string& cfg, const std::string& args, const fs::path& a,
+                       const fs::path& b, const std::string& frame, double delay) {
+  REQUIRE(loam_test::run_loam("run " + cfg + " --out " + a.string() + args).exit_code == 0);
+  return loam_test::run_bash(std::string(LOAM_EXE) + " run " + cfg + " --out " + b.string() + args +
+                             " & pid=$!; while [ ! -e " + (b / frame).string() +
+                             " ] && kill -0 $pid 2>/dev/null; do sleep 0.01; done; sleep " +
+                             std::to_string(delay) + "; kill -INT $pid; wait $pid");
+}
+
+/// `--resume b` to the end: the summaries of the uninterrupted run a and of the resumed b.
+std::pair<nlohmann::json, nlohmann::json> resume_to_end(const std::string& cfg,
+                                                        const std::string& args, const fs::path& a,
+                                                        const fs::path& b) {
+  auto r = loam_test::run_loam("run " + cfg + " --resume " + b.string() + args);
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  auto sa = nlohmann::json::parse(loam_test::slurp(a / "summary.json"));
+  auto sb = nlohmann::json::parse(loam_test::slurp(b / "summary.json"));
+  CHECK(sb["status"] == "ok");
+  return {sa, sb};
+}
+
+/// The last frames of runs a and b (summaries sa, sb) hold the same `fields`, bit for bit.
+void check_same_last_frame(const fs::path& a, const nlohmann::json& sa, const fs::path& b,
+                           const nlohmann::json& sb, std::initializer_list<const char*> fields) {
+  char last_a[64], last_b[64];
+  std::snprintf(last_a, sizeof last_a, "particles_%06ld.h5", sa["frames"].get<long>() - 1);
+  std::snprintf(last_b, sizeof last_b, "particles_%06ld.h5", sb["frames"].get<long>() - 1);
+  for (const char* field : fields)
+    CHECK(loam_test::read_frame_doubles(a / last_a, field) ==
+          loam_test::read_frame_doubles(b / last_b, field));
+}
+
+}  // namespace
+
 TEST_CASE("an interrupted run resumes to the uninterrupted run's final state",
           "[checkpoint][interrupt]") {
   // SIGINT 0.5 s after the first frame writes a checkpoint with the last frame; `--resume DIR`
@@ -192,31 +232,15 @@ TEST_CASE("an interrupted run resumes to the uninterrupted run's final state",
   const std::string args =
       " --quiet --threads 1 --set time.end=5000 --set output.every_time=500 "
       "--set \"output.checkpoint={every_steps: 20000}\"";
-  REQUIRE(loam_test::run_loam("run " + cfg + " --out " + a.path.string() + args).exit_code == 0);
-  const int code = loam_test::run_bash(
-      std::string(LOAM_EXE) + " run " + cfg + " --out " + b.path.string() + args +
-      " & pid=$!; while [ ! -e " + (b.path / "particles_000000.h5").string() +
-      " ] && kill -0 $pid 2>/dev/null; do sleep 0.01; done; sleep 0.5; "
-      "kill -INT $pid; wait $pid");
+  const int code = run_then_interrupt(cfg, args, a.path, b.path, "particles_000000.h5", 0.5);
   auto interrupted = nlohmann::json::parse(loam_test::slurp(b.path / "summary.json"));
   std::printf("interrupted at step %ld (exit %d); resuming\n", interrupted["steps"].get<long>(),
               code);
   REQUIRE(code == 130);
-  auto r = loam_test::run_loam("run " + cfg + " --resume " + b.path.string() + args);
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  auto sa = nlohmann::json::parse(loam_test::slurp(a.path / "summary.json"));
-  auto sb = nlohmann::json::parse(loam_test::slurp(b.path / "summary.json"));
-  CHECK(sb["status"] == "ok");
+  const auto [sa, sb] = resume_to_end(cfg, args, a.path, b.path);
   for (const char* k : {"steps", "end_time", "energy_final", "verify", "mass", "dt_min", "dt_max"})
     CHECK(sa[k] == sb[k]);
-  const long fa = sa["frames"], fb = sb["frames"];
-  char last_a[64], last_b[64];
-  std::snprintf(last_a, sizeof last_a, "particles_%06ld.h5", fa - 1);
-  std::snprintf(last_b, sizeof last_b, "particles_%06ld.h5", fb - 1);
-  for (const char* field : {"position", "velocity", "stress"})
-    CHECK(loam_test::read_frame_doubles(a.path / last_a, field) ==
-          loam_test::read_frame_doubles(b.path / last_b, field));
+  check_same_last_frame(a.path, sa, b.path, sb, {"position", "velocity", "stress"});
   // The history has one row more (the interruption's step, unless it is a multiple of the
   // config's history_every of 10 steps, whose row is regular) and otherwise the same rows.
   std::ifstream ha(a.path / "history.csv"), hb(b.path / "history.csv");
@@ -301,11 +325,7 @@ TEST_CASE("Ctrl-C on the default scene without output.checkpoint resumes to the 
   loam_test::TempDir a("ckpt_ctrl_c_a"), b("ckpt_ctrl_c_b");
   const std::string cfg = std::string(LOAM_SOURCE_DIR) + "/configs/granular_collapse_2d.yaml";
   const std::string args = " --quiet --threads 1";
-  REQUIRE(loam_test::run_loam("run " + cfg + " --out " + a.path.string() + args).exit_code == 0);
-  const int code = loam_test::run_bash(
-      std::string(LOAM_EXE) + " run " + cfg + " --out " + b.path.string() + args +
-      " & pid=$!; while [ ! -e " + (b.path / "particles_000002.h5").string() +
-      " ] && kill -0 $pid 2>/dev/null; do sleep 0.01; done; kill -INT $pid; wait $pid");
+  const int code = run_then_interrupt(cfg, args, a.path, b.path, "particles_000002.h5", 0);
   REQUIRE(code == 130);
   long checkpoints = 0;
   for (const auto& e : fs::directory_iterator(b.path))
@@ -314,23 +334,54 @@ TEST_CASE("Ctrl-C on the default scene without output.checkpoint resumes to the 
   std::printf("granular collapse interrupted at step %ld: %ld checkpoint file(s); resuming\n",
               interrupted["steps"].get<long>(), checkpoints);
   CHECK(checkpoints == 1);
-  auto r = loam_test::run_loam("run " + cfg + " --resume " + b.path.string() + args);
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  auto sa = nlohmann::json::parse(loam_test::slurp(a.path / "summary.json"));
-  auto sb = nlohmann::json::parse(loam_test::slurp(b.path / "summary.json"));
-  CHECK(sb["status"] == "ok");
+  const auto [sa, sb] = resume_to_end(cfg, args, a.path, b.path);
   CHECK(sa["steps"] == sb["steps"]);
   CHECK(sa["verify"] == sb["verify"]);
-  const long fa = sa["frames"], fb = sb["frames"];
-  char last_a[64], last_b[64];
-  std::snprintf(last_a, sizeof last_a, "particles_%06ld.h5", fa - 1);
-  std::snprintf(last_b, sizeof last_b, "particles_%06ld.h5", fb - 1);
-  for (const char* field : {"position", "velocity", "stress", "plastic_strain_eq"})
-    CHECK(loam_test::read_frame_doubles(a.path / last_a, field) ==
-          loam_test::read_frame_doubles(b.path / last_b, field));
+  check_same_last_frame(a.path, sa, b.path, sb,
+                        {"position", "velocity", "stress", "plastic_strain_eq"});
   long left = 0;
   for (const auto& e : fs::directory_iterator(b.path))
     left += e.path().filename().string().rfind("checkpoint_", 0) == 0;
   CHECK(left == 0);
+}
+
+TEST_CASE("a staged run interrupted inside a stage resumes to the uninterrupted stages",
+          "[checkpoint][interrupt][stages]") {
+  // The interrupt checkpoint of a staged run leaves the interrupted stage's record out (the
+  // resumed run writes the stage's own), as a periodic checkpoint inside a stage does: the
+  // resumed run's stages[] and final frame equal the uninterrupted run's. Kept in the image,
+  // the record "interrupted" came back with the checkpoint and the stage was listed twice.
+  loam_test::TempDir a("ckpt_stages_a"), b("ckpt_stages_b"), c("ckpt_stages_cfg");
+  fs::create_directories(c.path);
+  const fs::path cfg = c.path / "staged.yaml";
+  std::ofstream(cfg) << "grid: {extent: [1.2], cell_size: 0.02}\n"
+                        "bodies:\n"
+                        "  - name: soil\n"
+                        "    generator: {type: box, min: [0], max: [1]}\n"
+                        "    material: {type: linear_elastic, E: 1.0e6, nu: 0, density: 1000}\n"
+                        "selections:\n"
+                        "  - {name: top, min: [0.99], max: [1]}\n"
+                        "boundaries:\n"
+                        "  - {type: fixed, face: x-}\n"
+                        "damping: {type: local, alpha: 0.1}\n"
+                        "output: {every_time: 10, fields: [velocity, stress]}\n"
+                        "stages:\n"
+                        "  - {name: rest, duration: 60}\n"
+                        "  - {name: load, duration: 60,\n"
+                        "     loads: [{type: traction, selection: top, face: x+, traction: "
+                        "[-1000]}]}\n";
+  const std::string args = " --quiet --threads 1";
+  const int code =
+      run_then_interrupt(cfg.string(), args, a.path, b.path, "particles_000002.h5", 0.2);
+  REQUIRE(code == 130);
+  auto interrupted = nlohmann::json::parse(loam_test::slurp(b.path / "summary.json"));
+  std::printf("staged run interrupted at t = %.3f s in stage %zu; resuming\n",
+              interrupted["end_time"].get<double>(), interrupted["stages"].size());
+  const auto [sa, sb] = resume_to_end(cfg.string(), args, a.path, b.path);
+  REQUIRE(sa["stages"].size() == 2);
+  REQUIRE(sb["stages"].size() == 2);
+  for (size_t k = 0; k < 2; ++k)
+    for (const char* key : {"name", "status", "start_time", "end_time", "steps", "energy"})
+      CHECK(sa["stages"][k][key] == sb["stages"][k][key]);
+  check_same_last_frame(a.path, sa, b.path, sb, {"position", "velocity", "stress"});
 }
