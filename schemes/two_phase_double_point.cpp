@@ -416,7 +416,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     const auto& s = sim.bodies[S.body[j]].spacing;
     double lattice = 1;
     for (int d = 0; d < D; ++d) lattice *= s[size_t(d)];
-    const double stretch = std::pow(S.col(S.volume)[j] / lattice, 1.0 / D);
+    const double ratio = S.col(S.volume)[j] / lattice;  // 1 at set-up
+    const double stretch = ratio == 1 ? 1.0 : std::pow(ratio, 1.0 / D);
     for (int d = 0; d < D; ++d) {
       const double half = 0.5 * s[size_t(d)] * stretch, r = x[d] - S.col(S.position, d)[j];
       if (!(std::fabs(r) <= half * (1 + 1e-9))) return false;
