@@ -214,7 +214,11 @@ typename Run<D>::CheckpointImage Run<D>::checkpoint_image() {
       [&](const char* name, auto& v) { image.scalars.emplace_back(name, double(v)); });
   image.momentum = ls_.e0.momentum;
   image.writer = writer_->state();
-  image.stages = stage_records_.dump();
+  // A stage the run was interrupted in has a record, "interrupted", that a resumed run replaces
+  // with the stage's own: the image holds the stages ended before it, as one taken mid-stage.
+  nlohmann::json stages = stage_records_;
+  if (!stages.empty() && stages.back()["status"] == "interrupted") stages.erase(stages.size() - 1);
+  image.stages = stages.dump();
   const Simulation<D>& sim = *sim_;
   std::vector<double> state;
   if (sim.reference && sim.reference->save_state(state))
@@ -808,16 +812,11 @@ RunResult Run<D>::loop() {
       if (ls_.frame_step != sim.step) write_frame("");
       sample_probes(true);
       if (ls_.history_step != sim.step) write_history();
-      // Resumable from inside a stage, as from a periodic checkpoint: the stage's record
-      // ("interrupted") stays out of the image, the resumed run writes the stage's own. Not
-      // from inside the strength reduction: its search would start again from a stage ended.
+      // Resumable from inside a stage (checkpoint_image), not from inside the strength
+      // reduction: its search would start again from a stage ended.
       const bool in_search = srf.is_object() && srf.value("status", "") == "interrupted";
       if (checkpoint_problem().empty() && !in_search) {
-        const nlohmann::json records = stage_records_;
-        if (!records.empty() && records.back()["status"] == "interrupted")
-          stage_records_.erase(stage_records_.size() - 1);
         write_checkpoint(checkpoint_image());
-        stage_records_ = records;
         resumable = true;
       }
     });

@@ -444,9 +444,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     return std::max(cell_porosity(c), std::min(1.0, cell_liquid_[c] * inv_cell_volume_));
   }
   /// Per cell the liquid points' volume sum V at the start of the step, and each liquid point's
-  /// cell (liquid_cell_, indexed by point). A point's cell lies in its stencil: the scatter's
-  /// colouring keeps the sums race-free.
-  /// In point order (framework/cell_sums.hpp): bitwise the same at any thread count.
+  /// cell (liquid_cell_, indexed by point), summed in point order (framework/cell_sums.hpp):
+  /// bitwise the same at any thread count.
   void liquid_cell_volumes(Simulation<D>& sim) {
     const Particles<D>& P = sim.sets[kLiquid].particles;
     const double* V = P.col(P.volume);

@@ -311,13 +311,15 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// space (the volume-weighted mean, or the linear fit for B-splines). Without it the pressure
   /// field has one degree of freedom per particle against one velocity per node: a pressure
   /// alternating from particle to particle exerts (nearly) no nodal force, so nothing restrains it,
-  /// and once particles cross cells the storage equation feeds it (soft column of issue 6: +-2 MPa
-  /// under a 50 kPa load, then the porosity leaves (0, 1)). One pressure per cell is the
-  /// constant-pressure (Q1-P0) element of mixed finite elements and the element-wise
-  /// liquid-pressure smoothing of the Anura3D v-w code; it conserves the volume integral of p in
-  /// each cell. With B-splines it is not in equilibrium with the weight where a free surface cuts
-  /// their support (framework/cell_projection.hpp). Averaging only the increments is not enough:
-  /// the checkerboard left by particles that change cells stays frozen (+-9 kPa).
+  /// and once particles cross cells the storage equation feeds it (the soft column of
+  /// configs/seed001_large_strain.yaml: +-2 MPa under a 50 kPa load, then a porosity outside
+  /// the range 0 to 1). One pressure per cell is the constant-pressure (Q1-P0) element of mixed
+  /// finite elements and the element-wise liquid-pressure smoothing of the Anura3D v-w code; it
+  /// conserves the volume integral of p in each cell. With B-splines it is not in equilibrium with
+  /// the weight where a free surface cuts their support (framework/cell_projection.hpp). Averaging
+  /// only the increments is not enough: the checkerboard left by particles that change cells stays
+  /// frozen
+  /// (+-9 kPa).
   void apply_pressure_increment(Simulation<D>& sim) {
     Particles<D>& P = sim.sets[0].particles;
     const long np = long(P.size());
