@@ -55,6 +55,22 @@
 //      pressure work balances the stored energy (the interpolated form of eq. 12 drifted unstable
 //      under gravity); n the liquid point's porosity of the step (liquid_porosity). In pure water
 //      it is V (1 + dt tr L_w), the single-phase update to O(dt^2).
+//      Partly filled pores: the rate is that of the pore volume, which the water fills only
+//      when the pores are saturated. With air in them a compression goes to the air first: the
+//      water takes the share r(S) of it,
+//        V <- V (1 + dt r(S) (1/n) sum_I [...]) where the sum is negative,
+//        r = clamp((S - S_c) / (S_o - S_c), 0, 1),
+//      an expansion relieves the water in full, and where r < 1 the water takes no tension
+//      (V <= m / rho_0 after the smoothing: capillary suction is not modelled). S is the degree
+//      of saturation interpolated from the nodes, S_I = sum_w (m / rho_0) N_I / sum_s n V N_I
+//      (the amount of water over the soil's pore volume, at most 1; smooth as points move, where
+//      a count per cell jumps by a point's volume), S_c (air_continuous_below, 0.8) and S_o
+//      (air_occluded_above, 0.9) roughly the range over which the pore air passes from a
+//      continuous phase open to the atmosphere to occluded bubbles (Fredlund & Rahardjo 1993,
+//      Soil Mechanics for Unsaturated Soils, ch. 2): a soil with air in half its pores carries a
+//      load on its skeleton, and water rising into dry sand takes no suction. The water's
+//      pressure still acts over the part of the cell it fills (V/n), i.e. on the mixture as
+//      S p (Bishop's chi = S).
 //      The fluid material then gives sigma_w from m/V and L_w (pressure, viscosity, cavitation).
 // Fluidisation (max_porosity: n_max, seed 003 section 2 and Anura3D): a solid point in contact
 // whose porosity reaches n_max is fluidised (`contact` 0): it carries no effective stress (the
@@ -122,6 +138,22 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         .def("0.9")
         .min(0)
         .max(1);
+    s.real("air_continuous_below", "-",
+           "partly filled pores: below this degree of saturation S the pore air is continuous "
+           "and escapes, and the water takes none of a compression of the pores (it builds no "
+           "pressure when the soil is compressed); between it and air_occluded_above the "
+           "water's share rises linearly; an expansion relieves the water in full, and with "
+           "air in the pores it takes no tension (docs/verification.md F)")
+        .def("0.8")
+        .min(0)
+        .max(1);
+    s.real("air_occluded_above", "-",
+           "above this degree of saturation the air is in occluded bubbles and the water takes "
+           "the whole compression (the saturated response); 0 for both: pores are treated as "
+           "full wherever water is")
+        .def("0.9")
+        .min(0)
+        .max(1);
     s.choice("free_surface_pressure", {"free", "zero"},
              "free: the flagged points keep the pressure of their density; zero: they are set to "
              "zero pressure (V = m / rho_0), as Anura3D does. zero needs the cells below the "
@@ -130,6 +162,11 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         .def("free");
     add_transfer_params(s, "; gimp, bspline2 or cpdi");
     s.check([](const Params& p, Diagnostics& d) {
+      if (p.real("air_continuous_below") > p.real("air_occluded_above"))
+        d.error(p.where("air_continuous_below"), p.path("air_continuous_below"),
+                "air_continuous_below " + format_number(p.real("air_continuous_below")) +
+                    " exceeds air_occluded_above " + format_number(p.real("air_occluded_above")) +
+                    ": the water's share of the pore volume change must rise with saturation");
       if (p.has("max_porosity") && p.real("max_porosity") <= p.real("porosity"))
         d.error(p.where("max_porosity"), p.path("max_porosity"),
                 "max_porosity " + format_number(p.real("max_porosity")) +
@@ -149,6 +186,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         smooth_(p.text("pressure_smoothing") == "cell"),
         n_max_(p.has("max_porosity") ? p.real("max_porosity") : 2.0),
         free_filling_(p.real("free_surface_filling")),
+        air_continuous_(p.real("air_continuous_below")),
+        air_occluded_(p.real("air_occluded_above")),
         zero_surface_pressure_(p.text("free_surface_pressure") == "zero") {}
 
   int phases() const override { return 2; }
@@ -178,6 +217,13 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     free_surface_ = sim.request_field(
         {"free_surface", 1, "-", "1: in a cell the water fills less than free_surface_filling", {}},
         kLiquid);
+    saturation_ = sim.request_field(
+        {"saturation",
+         1,
+         "-",
+         "degree of saturation S of the soil's pores around the point (1 where no soil is)",
+         {}},
+        kLiquid);
     drag_->setup(sim, diag);
     node_.assign(sim.grid.num_nodes * S, 0.0);
     solved_.assign(sim.grid.num_nodes * 2 * D, 0.0);
@@ -186,6 +232,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     inv_cell_volume_ = 1;
     for (int d = 0; d < D; ++d) inv_cell_volume_ *= sim.grid.inv_cell[size_t(d)];
     cell_solid_.assign(sim.grid.num_cells, 0.0);
+    for (const auto& m : sim.materials) inv_density_.push_back(1 / m->density());
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
     initialize_particles(sim, sim.sets[kSolid], 0, sim.sets[kSolid].size());
@@ -235,9 +282,49 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     }
   }
 
-  /// The liquid points' pore_pressure from their initial stress, for the first frame.
+  /// The liquid points' pore_pressure from their initial stress and their degree of
+  /// saturation, for the first frame.
   void initial_state(Simulation<D>& sim) override {
     water_pressure(sim.sets[kLiquid].particles, 0, sim.sets[kLiquid].size());
+    initial_saturation(sim);
+  }
+
+  /// The nodal water and pore volumes of the set-up (the step's scatter of them alone), S_I,
+  /// and S interpolated at the liquid points.
+  void initial_saturation(Simulation<D>& sim) {
+    zero_nodes(node_, sim.threads);
+    sim.scatter_blocks([&](ParticleSet<D>& set, size_t b, int count, int thread) {
+      const Particles<D>& P = set.particles;
+      StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
+      sim.shape->evaluate(sim.grid, P, b, count, st);
+      const bool solid = &set == &sim.sets[kSolid];
+      for (int p = 0; p < count; ++p) {
+        const size_t i = b + size_t(p);
+        const double v = solid ? P.col(n_)[i] * P.col(P.volume)[i]
+                               : P.col(P.mass)[i] * inv_density_[P.material[i]];
+        for (int k = 0; k < st.npp; ++k) {
+          const size_t kp = size_t(k) * kBlock + size_t(p);
+          node_[size_t(st.node[kp]) * S + (solid ? kPore : kSat)] += st.w[kp] * v;
+        }
+      }
+    });
+    sim.complete_nodes({{node_.data(), S, S}});
+    for_each_record(sim,
+                    [&](double* r, size_t) { r[kSat] = degree_of_saturation(r[kSat], r[kPore]); });
+    auto& liquid = sim.sets[kLiquid];
+    liquid.gather_blocks([&](size_t b, int count, int thread) {
+      Particles<D>& P = liquid.particles;
+      StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
+      sim.shape->evaluate(sim.grid, P, b, count, st);
+      for (int p = 0; p < count; ++p) {
+        double s = 0;
+        for (int k = 0; k < st.npp; ++k) {
+          const size_t kp = size_t(k) * kBlock + size_t(p);
+          s += st.w[kp] * node_[size_t(st.node[kp]) * S + kSat];
+        }
+        P.col(saturation_)[b + size_t(p)] = s;
+      }
+    });
   }
 
   double stable_dt(const Simulation<D>& sim) const override {
@@ -282,9 +369,11 @@ class TwoPhaseDoublePoint : public Scheme<D> {
  private:
   static constexpr int kSolid = 0, kLiquid = 1;
   // Node record: solid and water mass, solid and water momentum -> velocity, solid and water
-  // force -> acceleration, the weak form of div sigma_w (G), drag Q, solid volume -> porosity.
+  // force -> acceleration, the weak form of div sigma_w (G), drag Q, solid volume -> porosity,
+  // water volume -> degree of saturation, the solid points' pore volume.
   static constexpr int kMs = 0, kMw = 1, kV = 2, kW = 2 + D, kF = 2 + 2 * D, kFw = 2 + 3 * D,
-                       kG = 2 + 4 * D, kQ = 2 + 5 * D, kN = 3 + 5 * D, S = 4 + 5 * D;
+                       kG = 2 + 4 * D, kQ = 2 + 5 * D, kN = 3 + 5 * D, kSat = 4 + 5 * D,
+                       kPore = 5 + 5 * D, S = 6 + 5 * D;
   static constexpr TwoPhaseRecord kRecord{kMs, kMw, kQ, kV, kW, kF, kFw, kN, S};
   static constexpr int NS = Particles<D>::NS;
   // Smallest porosity a liquid point divides by (its mixture volume V/n): a liquid point inside
@@ -315,6 +404,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   double n_max_;  // fluidisation threshold (2: never)
   int contact_ = -1, free_surface_ = -1;
   double free_filling_;  // free-surface threshold of a cell's pore filling (0: none)
+  double air_continuous_, air_occluded_;  // the water's share of the pore volume change
+  int saturation_ = -1;
+  std::vector<double> inv_density_;  // per material: 1 / rho_0
   bool zero_surface_pressure_;
   std::vector<double> mixture_force_;  // per node (D values), while boundary forces are added
   struct Scratch : BlockScratch<D> {
@@ -576,7 +668,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * P.col(P.stress, voigt_index(d, j))[i];
       }
       if constexpr (AFFINE) affine_momenta<NPP>(P, B, st, p, i, npp, ms[p], mv, as, am);
-      const double vq = V[p] * sc.Q[size_t(p)], vs = (1 - n[p]) * V[p];
+      const double vq = V[p] * sc.Q[size_t(p)], vs = (1 - n[p]) * V[p], vp = n[p] * V[p];
       cell_solid_[particle_cell(sim.grid, P, i)] += vs;  // in the stencil: race-free
       for_each_entry<FORM>(
           npp, [&](int k) __attribute__((always_inline)) {
@@ -586,6 +678,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
             r[kMs] += w * ms[p];
             r[kQ] += w * vq;
             r[kN] += w * vs;
+            r[kPore] += w * vp;
             for (int d = 0; d < D; ++d) {
               r[kV + d] += w * (AFFINE ? am.at(k, d) : mv[d]);  // APIC: the affine momentum
               double f = w * body[d];
@@ -642,6 +735,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       const size_t i = b + size_t(p);
       n[p] = liquid_porosity(liquid_cell_[i]);  // the solid set is scattered first
       const double Vmix = V[p] / n[p];
+      const double free_volume = mw[p] * inv_density_[P.material[i]];  // at p = 0
       double mv[D], body[D], sv[D][D];
       for (int d = 0; d < D; ++d) {
         mv[d] = mw[p] * P.col(P.velocity, d)[i];
@@ -656,6 +750,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
             const double w = st.w[kp];
             double* r = g + size_t(st.node[kp]) * S;
             r[kMw] += w * mw[p];
+            r[kSat] += w * free_volume;
             for (int d = 0; d < D; ++d) {
               r[kW + d] += w * (AFFINE ? am.at(k, d) : mv[d]);  // APIC: the affine momentum
               r[kFw + d] += w * body[d];
@@ -681,11 +776,13 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     constrain_two_phase_update<D>(sim, node_.data(), kRecord, solved_.data(), dt);
   }
 
-  /// n_I = 1 - V_s,I / V_I in [0, 1]; F_w += n_I G_I, F_s += (1 - n_I) G_I (see the header).
+  /// n_I = 1 - V_s,I / V_I in [0, 1]; F_w += n_I G_I, F_s += (1 - n_I) G_I (see the header);
+  /// the degree of saturation S_I.
   void porosity_and_liquid_stress(Simulation<D>& sim) {
     for_each_record(sim, [&](double* r, size_t i) {
       const double n = std::clamp(1.0 - r[kN] / vol_[i], 0.0, 1.0);
       r[kN] = n;
+      r[kSat] = degree_of_saturation(r[kSat], r[kPore]);
       for (int d = 0; d < D; ++d) {
         r[kFw + d] += n * r[kG + d];
         r[kF + d] += (1 - n) * r[kG + d];
@@ -913,6 +1010,22 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     if (fluidised) zero_effective_stress(P, b, count);
   }
 
+  /// S_I = (sum_liquid (m / rho_0) N_I) / (sum_solid n V N_I): the water's volume at zero
+  /// pressure (its amount, whatever its pressure) over the soil's pore volume at the node, at most
+  /// 1 (free water over the soil fills its pores); 1 where no soil is (pure water's free surface is
+  /// its own density's business).
+  static double degree_of_saturation(double water, double pores) {
+    return pores > 0 ? std::min(1.0, water / pores) : 1.0;
+  }
+  /// The fraction of a compression of the pores the water takes at degree of saturation S: 0
+  /// while the pore air is continuous and escapes (S <= air_continuous_below), 1 once it is
+  /// occluded (S >= air_occluded_above), linear between.
+  double water_share(double saturation) const {
+    if (saturation >= air_occluded_) return 1.0;
+    if (saturation <= air_continuous_) return 0.0;
+    return (saturation - air_continuous_) / (air_occluded_ - air_continuous_);
+  }
+
   static double volume_rate(const double (&l)[D][D]) {
     double tr = 0;
     for (int d = 0; d < D; ++d) tr += l[d][d];
@@ -948,12 +1061,13 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       // L_w, and the storage rate sum_I [ (1 - n_I) v_I + n_I w_I ] . grad N_I: the discrete
       // div((1 - n) u_s) + div(n u_w) with the nodal products, the adjoint of the shared
       // liquid stress (n_I G_I to the water, (1 - n_I) G_I to the solid).
-      double lw[D][D] = {}, rate = 0;
+      double lw[D][D] = {}, rate = 0, saturation = 0;
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
         const size_t node = size_t(st.node[kp]);
         const double* vr = remap_.data() + node * 2 * D;
         const double n_I = g[node * S + kN];
+        saturation += st.w[kp] * g[node * S + kSat];
         add_velocity_gradient<D>(lw, vr + D, st, size_t(k), p);
         for (int d = 0; d < D; ++d)
           rate += ((1 - n_I) * vr[d] + n_I * vr[D + d]) *
@@ -963,7 +1077,10 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       for (int a = 0; a < D; ++a)
         for (int c = 0; c < D; ++c) lw_[i * D * D + size_t(a * D + c)] = lw[a][c];
       if (F[0]) update_deformation_gradient<D>(F, lw, dt, p);
-      const double factor = 1 + dt * rate / P.col(n_)[i];  // n: the step's, from the scatter
+      P.col(saturation_)[i] = saturation;
+      // n: the step's, from the scatter; the water's share of a compression of the pores
+      const double share = water_share(saturation);
+      const double factor = 1 + dt * (share == 1 || rate > 0 ? rate : share * rate) / P.col(n_)[i];
       P.col(P.volume)[i] *= factor;
       if (!(factor > 0)) sc.bad_volume = long(i);
     }
@@ -988,6 +1105,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   ///   sample, its cells fill less than 0.9, and zero pressure there put Ergun's flux off by
   ///   6.8 % (docs/verification.md F). The weakly compressible water needs no help at a free
   ///   surface: its pressure follows its own density there too.
+  /// - partly filled pores (the water's share of a compression r(S) < 1): the water takes no
+  ///   tension (V <= m / rho_0): capillary suction is not modelled.
   void liquid_cells(Simulation<D>& sim) {
     Particles<D>& P = sim.sets[kLiquid].particles;
     const double* m = P.col(P.mass);
@@ -999,18 +1118,22 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     });
     const long np = long(P.size());
     double* flag = P.col(free_surface_);
+    const double* saturation = P.col(saturation_);
     const double filling = free_filling_;
 #pragma omp parallel for schedule(static) num_threads(sim.threads)
     for (long i = 0; i < np; ++i) {
       const size_t c = cells_.cell(size_t(i));
       const bool surface = cells_.weight(c) < filling * cell_porosity(c) / inv_cell_volume_;
       flag[i] = surface ? 1.0 : 0.0;
+      const double share = water_share(saturation[i]);
+      const double v0 = m[i] / sim.materials[P.material[size_t(i)]]->density();  // at p = 0
       if (surface && zero_surface_pressure_)
-        V[i] = m[i] / sim.materials[P.material[size_t(i)]]->density();
+        V[i] = v0;
       else if (smooth_ && degree == CellPressure::kConstant)
         V[i] = m[i] * cells_.weight(c) / cells_.weighted_value(c);
       else if (smooth_)
         V[i] = m[i] / cells_.at(sim.grid, P, size_t(i));
+      if (share < 1) V[i] = std::min(V[i], v0);  // no suction in partly filled pores
     }
   }
 
