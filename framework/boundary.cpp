@@ -46,6 +46,13 @@ void add_phase_param(Schema& s) {
       .def("both");
 }
 
+void add_reaction_name(Schema& s) {
+  s.text("name",
+         "name of this condition's reaction (the force it applies on the model) in history.csv "
+         "(reaction_<name>_x, ...; two-phase schemes also reaction_<name>_water_x, ...) and "
+         "summary.json; default <type>_<face>, or <type>_<position in the list> for a box");
+}
+
 int parse_phase_mask(const Params& p) {
   const std::string ph = p.text("phase");
   return ph == "solid" ? 1 : ph == "water" ? 2 : 3;

@@ -163,6 +163,10 @@ class Boundary {
   /// The axis along which this condition makes the grid periodic (particles leaving through
   /// one face of it enter through the other: HeldFaces), or -1 (default).
   virtual int periodic_axis() const { return -1; }
+  /// The nodes where this mechanical condition acts, for its reaction (framework/reactions.hpp:
+  /// the force it applies there), after setup; nullptr (default): it reports none (hydraulic
+  /// conditions, periodic faces).
+  virtual const std::vector<size_t>* reaction_nodes() const { return nullptr; }
 };
 
 /// The nodes on one face of the grid ("x-", "x+", "y-", ...), for face-based plugins.
@@ -248,6 +252,10 @@ template <int D>
 std::vector<double> face_node_areas(const Grid<D>& grid, const Face& face,
                                     const std::vector<size_t>& nodes);
 const std::vector<std::string>& face_names();
+
+/// The optional `name` of a mechanical condition: its reaction's columns in history.csv and
+/// its entry in summary.json (framework/reactions.hpp).
+void add_reaction_name(Schema& s);
 
 /// A condition on a box of nodes inside the grid instead of a face (fixed, slip: a sheet pile,
 /// a wall, a footing): the schema keys `min` and `max` beside `face`, exactly one of the two

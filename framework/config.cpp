@@ -282,6 +282,7 @@ Schema config_schema() {
     p.vector("particle_near", "m", "follow the particle nearest to this point at t = 0");
     p.text("set", "with particle_near: the particle set to search (default: the scheme's first)");
     p.vector("node", "-", "grid node indices (i, j, k)");
+    p.vector("node_near", "m", "the grid node nearest to this point");
     p.string_list("fields", "fields to record").def("[position, velocity]");
     p.integer("every_steps", "sample every N steps").def("1").min(1);
     s.section_list("probes", p, "time series at a particle or a node, written as CSV");

@@ -23,6 +23,24 @@ bool derived_field(const std::string& name) {
 
 }  // namespace
 
+/// The grid indices of the node nearest to a probe's node_near point; a point outside the grid
+/// is a located error (then the nearest node inside).
+template <int D>
+std::vector<double> Run<D>::nearest_node(const Params& pr, Diagnostics& diag) const {
+  const Grid<D>& g = sim_->grid;
+  const auto& x = pr.vec("node_near");
+  std::vector<double> ijk(static_cast<size_t>(D), 0.0);
+  bool inside = true;
+  for (int d = 0; d < D; ++d) {
+    const double t = (x[size_t(d)] - g.origin[size_t(d)]) / g.cell[size_t(d)];
+    inside = inside && t > -1e-9 && t < g.cells[d] + 1e-9;
+    ijk[size_t(d)] = double(std::clamp(std::lround(t), 0L, long(g.nodes[d] - 1)));
+  }
+  if (!inside)
+    diag.error(pr.where("node_near"), pr.path("node_near"), "the point is outside the grid");
+  return ijk;
+}
+
 template <int D>
 void Run<D>::check_outputs(Diagnostics& diag) {
   // strain_magnitude needs F and its value at the last reset: requested before the names are
@@ -32,7 +50,7 @@ void Run<D>::check_outputs(Diagnostics& diag) {
   };
   bool need_strain = names_strain(cfg_.params.section("output").strings("fields"));
   for (const auto& pr : cfg_.params.list("probes"))
-    need_strain = need_strain || (!pr.has("node") && names_strain(pr.strings("fields")));
+    need_strain = need_strain || (!pr.has("particle_near") && names_strain(pr.strings("fields")));
   if (need_strain) {
     reset_F_ = sim_->request_strain_reference();
     strain_magnitude_ = sim_->request_field(
@@ -83,9 +101,10 @@ void Run<D>::check_outputs(Diagnostics& diag) {
     Probe<D> probe;
     probe.name = pr.text("name");
     probe.every = pr.integer("every_steps");
-    probe.on_node = pr.has("node");
-    if (pr.has("node") == pr.has("particle_near")) {
-      diag.error(pr.where(), pr.path(), "give exactly one of 'particle_near' or 'node'");
+    probe.on_node = pr.has("node") || pr.has("node_near");
+    if (int(pr.has("node")) + int(pr.has("node_near")) + int(pr.has("particle_near")) != 1) {
+      diag.error(pr.where(), pr.path(),
+                 "give exactly one of 'particle_near', 'node' or 'node_near'");
       continue;
     }
     const auto& f = pr.strings("fields");
@@ -96,7 +115,7 @@ void Run<D>::check_outputs(Diagnostics& diag) {
       }
     if (probe.on_node) {
       std::array<int, D> node{};
-      const auto& ijk = pr.vec("node");
+      const auto ijk = pr.has("node") ? pr.vec("node") : nearest_node(pr, diag);
       for (int d = 0; d < D; ++d) {
         long k = std::lround(ijk[size_t(d)]);
         if (k < 0 || k >= sim_->grid.nodes[d] || std::fabs(ijk[size_t(d)] - double(k)) > 1e-9) {
@@ -238,6 +257,10 @@ void Run<D>::open_outputs(long resume_step) {
     history_.out() << ",momentum_"
                    << "xyz"[d];
   if (exchanges_particles()) history_.out() << ",particles,mass_created,mass_removed";
+  for (const auto& name : sim_->reactions.names())
+    for (int k = 0; k < sim_->scheme->phases(); ++k)
+      for (int d = 0; d < D; ++d)
+        history_.out() << ",reaction_" << name << (k ? "_water_" : "_") << "xyz"[d];
   history_.out() << "\n";
   for (auto& pr : probes_) {
     pr.csv.open(dir_ / ("probe_" + pr.name + ".csv"));
@@ -349,6 +372,10 @@ void Run<D>::write_history() {
   for (double m : e.momentum) o << "," << m;
   if (exchanges_particles())
     o << "," << size_t(exchanged[0]) << "," << exchanged[1] << "," << exchanged[2];
+  const Reactions<D>& r = sim_->reactions;
+  for (size_t c = 0; c < r.names().size(); ++c)
+    for (int k = 0; k < sim_->scheme->phases(); ++k)
+      for (int d = 0; d < D; ++d) o << "," << r.force(c)[k * D + d];
   o << "\n";
   history_.check();
 }

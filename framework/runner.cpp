@@ -229,6 +229,7 @@ typename Run<D>::CheckpointImage Run<D>::checkpoint_image() {
   for (size_t i = 0; i < sim.boundaries.size(); ++i)
     if (state.clear(), sim.boundaries[i]->save_state(state))
       image.plugins.emplace_back("plugin.boundary." + std::to_string(i), state);
+  if (!sim.reactions.empty()) image.plugins.emplace_back("sim.reactions", sim.reactions.state());
   return image;
 }
 
@@ -355,6 +356,7 @@ void Run<D>::restore_checkpoint() {
   for (size_t i = 0; i < sim.boundaries.size(); ++i)
     if (probe.clear(), sim.boundaries[i]->save_state(probe))
       sim.boundaries[i]->restore_state(r.doubles("plugin.boundary." + std::to_string(i)));
+  if (!sim.reactions.empty()) sim.reactions.restore(r.doubles("sim.reactions"));
   // The checkpoints of the run so far, and none from beyond this one (that future is redone).
   for (const auto& file : checkpoint_files(dir_, sim.ranks->file_tag())) {
     if (checkpoint_step(file, sim.ranks->file_tag()) > sim.step) {
@@ -510,7 +512,29 @@ nlohmann::json Run<D>::base_summary() const {
   sim_->ranks->sum(&bytes, 1);
   s["bytes_per_particle"] =
       particles > 0 ? size_t(bytes / particles) : sim_->sets[0].particles.bytes_per_particle();
+  if (!sim_->reactions.empty()) s["reactions"] = reaction_summary();
   return s;
+}
+
+/// Per mechanical condition the force it applied in the last step and the least and largest
+/// value of each component over the run's steps (N; per metre in 2D, per square metre in 1D),
+/// per phase: "force", "min", "max", and for the water of a two-phase scheme "water_force", ...
+template <int D>
+nlohmann::json Run<D>::reaction_summary() const {
+  const Reactions<D>& r = sim_->reactions;
+  nlohmann::json out = nlohmann::json::object();
+  for (size_t c = 0; c < r.names().size(); ++c) {
+    nlohmann::json e;
+    for (int k = 0; k < sim_->scheme->phases(); ++k) {
+      const std::string pre = k ? "water_" : "";
+      const size_t at = size_t(k * D);
+      e[pre + "force"] = std::vector<double>(r.force(c) + at, r.force(c) + at + D);
+      e[pre + "min"] = std::vector<double>(r.lowest(c) + at, r.lowest(c) + at + D);
+      e[pre + "max"] = std::vector<double>(r.highest(c) + at, r.highest(c) + at + D);
+    }
+    out[r.names()[c]] = e;
+  }
+  return out;
 }
 
 template <int D>

@@ -39,10 +39,12 @@ bool Simulation<D>::advance(double step_dt, bool check) {
   const bool checked = check || (step + 1) % check_every == 0;
   const bool track = checked && track_motion;
   if (track) timed("motion", [&] { keep_positions(); });
+  reactions.begin_step();
   scheme->step(*this, dt);
   time += dt;
   ++step;
   const bool distributed = ranks->distributed();
+  reactions.end_step(*ranks);
   if (distributed) failure = ranks->first_message(failure);  // one rank's failure stops all
   if (!failure.empty()) return false;
   // The largest particle speed over the ranks: the time step's CFL bound is then the serial

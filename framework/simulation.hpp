@@ -23,6 +23,7 @@
 #include "params.hpp"
 #include "particle_set.hpp"
 #include "ranks.hpp"
+#include "reactions.hpp"
 #include "reference.hpp"
 #include "scheme.hpp"
 #include "shape_function.hpp"
@@ -67,6 +68,8 @@ class Simulation {
   std::vector<std::unique_ptr<Material<D>>> materials;  // one per body, index = material id
   std::vector<Body> bodies;
   std::vector<std::unique_ptr<Boundary<D>>> boundaries;
+  /// The reaction of every mechanical condition of the run (its stages' included), per step.
+  Reactions<D> reactions;
   std::vector<std::unique_ptr<Load<D>>> loads;
   std::vector<std::unique_ptr<Source<D>>> sources;
   std::vector<std::unique_ptr<Sink<D>>> sinks;
@@ -149,6 +152,7 @@ class Simulation {
   ///     in the remaining free subspace; several friction faces scale the same free vector, so
   ///     their order does not matter either);
   ///  4. the hydraulic conditions on the water.
+  /// Each mechanical condition's reaction is measured around its passes (reactions).
   void constrain_update(const GridUpdate& update) {
     GridUpdate u = update;
     u.time = time - loads_start;
@@ -160,9 +164,10 @@ class Simulation {
       for (const auto& b : boundaries)
         if (b->hydraulic() == (pass == 0)) b->before_constraints(u);
     for (const auto& b : boundaries)
-      if (!b->hydraulic()) b->constrain_grid_update(u);
+      if (!b->hydraulic())
+        reactions.measure(*b, u, grid, *ranks, [&] { b->constrain_grid_update(u); });
     for (const auto& b : boundaries)
-      if (!b->hydraulic()) b->coulomb_update(u);
+      if (!b->hydraulic()) reactions.measure(*b, u, grid, *ranks, [&] { b->coulomb_update(u); });
     for (const auto& b : boundaries)
       if (b->hydraulic()) b->constrain_grid_update(u);
     timed("check_grid", [&] { check_grid(u); });
@@ -215,7 +220,10 @@ class Simulation {
     for (const auto& l : loads) l->apply_to_grid(*this, force, time - loads_start);
   }
   void apply_damping(const NodeForces& nf) {
-    if (damping) damping->apply(*this, nf);
+    if (!damping) return;
+    if (!reactions.empty()) reactions.before_damping(nf.force, grid, *ranks);
+    damping->apply(*this, nf);
+    if (!reactions.empty()) reactions.after_damping(nf.force);
   }
   /// f(set, begin, count, thread) over the blocks of every set: race-free scatters set after
   /// set (one grid), gathers on all threads.

@@ -36,6 +36,32 @@ void check_periodic_faces(const std::vector<std::unique_ptr<Boundary<D>>>& list,
   }
 }
 
+/// Register each mechanical condition of a list under its reaction's name (`name`, else
+/// <type>_<face>, or <type>_<position> for a box); a name given twice in one list is a located
+/// error (its two forces would share a column).
+template <int D>
+void name_reactions(const std::vector<std::unique_ptr<Boundary<D>>>& list,
+                    const std::vector<Params>& params, Reactions<D>& reactions, Diagnostics& diag) {
+  std::vector<std::string> names;
+  for (size_t i = 0; i < list.size() && i < params.size(); ++i) {
+    if (!list[i]->reaction_nodes()) continue;
+    const Params& p = params[i];
+    const std::string name = p.has("name")   ? p.text("name")
+                             : p.has("face") ? p.type() + "_" + p.text("face")
+                                             : p.type() + "_" + std::to_string(i);
+    if (std::find(names.begin(), names.end(), name) != names.end()) {
+      const std::string why = "another condition of this list reports its reaction as '" + name +
+                              "': give each a distinct name";
+      if (p.has("name"))
+        diag.error(p.where("name"), p.path("name"), why);
+      else
+        diag.error(p.where(), p.path(), why);
+    }
+    names.push_back(name);
+    reactions.add(list[i].get(), name);
+  }
+}
+
 }  // namespace
 
 template <int D>
@@ -108,6 +134,10 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   for (size_t k = 0; k < stages.size(); ++k)
     if (stages[k].sets_boundaries)
       check_periodic_faces(stages[k].boundaries, stages[k].params.list("boundaries"), diag);
+  name_reactions(boundaries, config.list("boundaries"), reactions, diag);
+  for (size_t k = 0; k < stages.size(); ++k)
+    if (stages[k].sets_boundaries)
+      name_reactions(stages[k].boundaries, stages[k].params.list("boundaries"), reactions, diag);
   held_faces = HeldFaces<D>(grid, boundaries);
   held_faces_water = HeldFaces<D>(grid, boundaries, 1);
   model_checked = true;

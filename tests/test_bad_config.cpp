@@ -477,8 +477,9 @@ probes:
     particle_near: [2]
     node: [2]
 )");
-  require_rejected(
-      s, r, {s.error_at(11, 5, "probes.0", "give exactly one of 'particle_near' or 'node'")});
+  require_rejected(s, r,
+                   {s.error_at(11, 5, "probes.0",
+                               "give exactly one of 'particle_near', 'node' or 'node_near'")});
 }
 
 TEST_CASE("a non-empty output directory is not touched without --overwrite", "[bad_config]") {

@@ -1047,6 +1047,53 @@ TEST_CASE("mpirun: strength reduction on ranks finds the serial factor of safety
   }
 }
 
+TEST_CASE("mpirun: a fixed base's reaction is the serial one and the column's weight",
+          "[mpi][mpi_run][reactions]") {
+  // framework/reactions.hpp on ranks: each rank sums the nodes it owns, the step's values are
+  // summed over the ranks. A 1 x 4 m elastic column (rho 2000, geostatic start, fixed base,
+  // slip sides, local damping) cut in 2 and 4 blocks: every history row's base reaction within
+  // 1e-9 of the serial run's (round-off of the sums' order), and its mean over the run within
+  // 0.1 % of the weight W = rho g H = 78 480 N/m (statics).
+  TempDir dir("mpi_reactions");
+  fs::create_directories(dir.path);
+  std::ofstream(dir.path / "run.yaml")
+      << "grid: {origin: [0, 0], extent: [1.0, 4.5], cell_size: 0.125}\n"
+         "gravity: [0, -9.81]\n"
+         "bodies:\n  - name: column\n    generator: {type: box, min: [0, 0], max: [1.0, 4]}\n"
+         "    material: {type: linear_elastic, E: 1.0e8, nu: 0.3, density: 2000}\n"
+         "    stress: {type: linear_profile, value: [0, 0, 0, 0], gradient: [8408.571, 19620, "
+         "8408.571, 0], axis: 1, origin: 4}\n"
+         "boundaries:\n  - {type: fixed, face: y-, name: base}\n  - {type: slip, face: x-}\n"
+         "  - {type: slip, face: x+}\n"
+         "damping: {type: local, alpha: 0.3}\n"
+         "time: {end: 0.05}\n"
+         "output: {every_time: 1.0, history_every: 1, history_digits: 17}\n";
+  const auto serial = run_on(dir.path, "serial", 0);
+  INFO(serial.output);
+  REQUIRE(serial.exit_code == 0);
+  const auto y0 =
+      loam_test::read_csv_columns(dir.path / "serial" / "history.csv")["reaction_base_y"];
+  REQUIRE(y0.size() > 10);
+  const double W = 2000 * 9.81 * 4;
+  for (int ranks : {2, 4}) {
+    const std::string out = "np" + std::to_string(ranks);
+    const auto r = run_on(dir.path, out, ranks);
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    const auto y = loam_test::read_csv_columns(dir.path / out / "history.csv")["reaction_base_y"];
+    REQUIRE(y.size() == y0.size());
+    double worst = 0, mean = 0;
+    for (size_t k = 0; k < y.size(); ++k) worst = std::max(worst, std::fabs(y[k] - y0[k]) / W);
+    for (size_t k = 1; k < y.size(); ++k) mean += y[k] / double(y.size() - 1);
+    std::printf(
+        "reaction on %d ranks: largest difference from serial %.2e W, mean %.2f N/m "
+        "(W %.0f, %+.4f %%)\n",
+        ranks, worst, mean, W, 100 * (mean / W - 1));
+    CHECK(worst <= 1e-9);
+    CHECK(std::fabs(mean / W - 1) <= 1e-3);
+  }
+}
+
 TEST_CASE("mpirun: a CPDI domain that outgrows the ghost layer stops every rank with the reason",
           "[mpi][mpi_run][cpdi]") {
   // docs/parallel.md: under mpirun CPDI runs with gimp's ghost layer (one row below, two above),

@@ -69,6 +69,7 @@ class Absorbing : public Boundary<D> {
       "tangential, implicit; two-phase: impermeable, undrained mixture impedance)";
   static Schema schema() {
     Schema s;
+    add_reaction_name(s);
     s.choice("face", face_names(), "grid face carrying the dashpots").required();
     s.real("density", "kg/m^3",
            "mass density rho of the material next to the face (two-phase: saturated density "
@@ -176,6 +177,8 @@ class Absorbing : public Boundary<D> {
       }
     }
   }
+
+  const std::vector<size_t>* reaction_nodes() const override { return &nodes_; }
 
  private:
   /// v <- factor v for component d of node n, with a consistent acceleration.

@@ -17,6 +17,7 @@ class Fixed : public Boundary<D> {
   static constexpr const char* summary = "no-slip grid face: all velocity components zero";
   static Schema schema() {
     Schema s;
+    add_reaction_name(s);
     add_face_or_box_params(s, /*face_required_otherwise=*/true);
     add_phase_param(s);
     return s;
@@ -49,6 +50,8 @@ class Fixed : public Boundary<D> {
   int holds_face(int phase) const override {
     return applies_to(phase) && !box_ ? face_index(face_) : -1;
   }
+
+  const std::vector<size_t>* reaction_nodes() const override { return &nodes_; }
 
  private:
   Params params_;

@@ -35,6 +35,7 @@ class Friction : public Boundary<D> {
       "at edges it slides only in the components other faces leave free)";
   static Schema schema() {
     Schema s;
+    add_reaction_name(s);
     s.choice("face", face_names(), "grid face").required();
     s.real("coefficient", "-",
            "Coulomb friction coefficient mu = tan(interface friction angle); per step the "
@@ -113,6 +114,8 @@ class Friction : public Boundary<D> {
       }
     }
   }
+
+  const std::vector<size_t>* reaction_nodes() const override { return &nodes_; }
 
  private:
   bool into_face(double vn) const { return face_.upper ? vn > 0 : vn < 0; }

@@ -26,6 +26,7 @@ class PrescribedVelocity : public Boundary<D> {
       "grid face or box of nodes moving at a prescribed velocity (platens, displacement control)";
   static Schema schema() {
     Schema s;
+    add_reaction_name(s);
     add_face_or_box_params(s, /*face_required_otherwise=*/true);
     add_phase_param(s);
     s.vector("velocity", "m/s", "the velocity (only the components in `directions` are used)")
@@ -85,6 +86,8 @@ class PrescribedVelocity : public Boundary<D> {
     for (size_t n : nodes_)
       for (int d : dirs_) held.hold(n, d);
   }
+
+  const std::vector<size_t>* reaction_nodes() const override { return &nodes_; }
 
  private:
   Params params_;

@@ -21,6 +21,7 @@ class Slip : public Boundary<D> {
       "roller grid face: normal velocity zero (or chosen components)";
   static Schema schema() {
     Schema s;
+    add_reaction_name(s);
     add_face_or_box_params(s, /*face_required_otherwise=*/true);
     add_phase_param(s);
     s.string_list("directions",
@@ -58,6 +59,8 @@ class Slip : public Boundary<D> {
     const bool normal = std::find(fixed_.begin(), fixed_.end(), face_.axis) != fixed_.end();
     return normal && applies_to(phase) && !box_ ? face_index(face_) : -1;
   }
+
+  const std::vector<size_t>* reaction_nodes() const override { return &nodes_; }
 
  private:
   Params params_;
