@@ -167,7 +167,32 @@ class Boundary {
   /// the force it applies there), after setup; nullptr (default): it reports none (hydraulic
   /// conditions, periodic faces).
   virtual const std::vector<size_t>* reaction_nodes() const { return nullptr; }
+  /// Whether those nodes change from step to step (a rigid body's), so the reaction takes
+  /// them anew each time. Default false.
+  virtual bool reaction_nodes_move() const { return false; }
 };
+
+/// Set components `dirs` of `nodes` to `velocity` in the phases of u that `applies(k)` selects,
+/// at nodes with mass, keeping the acceleration consistent (a += (v - v*)/dt, so FLIP particles
+/// see the motion) and marking the components held (prescribed_velocity, rigid_body).
+template <int D, class Applies>
+void impose_velocity(const GridUpdate& u, const std::vector<size_t>& nodes,
+                     const std::vector<int>& dirs, const std::array<double, D>& velocity,
+                     Applies&& applies) {
+  for (int k = 0; k < u.count; ++k) {
+    if (!applies(k)) continue;
+    const PhaseUpdate& p = u.phases[size_t(k)];
+    for (size_t n : nodes) {
+      if (!(p.mass.at(n, 0) > 0)) continue;
+      for (int d : dirs) {
+        const double before = p.velocity.at(n, d);
+        p.velocity.at(n, d) = velocity[size_t(d)];
+        if (u.dt > 0) p.acceleration.at(n, d) += (velocity[size_t(d)] - before) / u.dt;
+        if (u.held[size_t(k)]) u.held[size_t(k)]->hold(n, d);
+      }
+    }
+  }
+}
 
 /// The nodes on one face of the grid ("x-", "x+", "y-", ...), for face-based plugins.
 struct Face {

@@ -57,7 +57,7 @@ class Reactions {
     const auto it = entries_.find(&b);
     if (it == entries_.end()) return act();
     Entry& e = it->second;
-    if (!e.ready) owned_nodes(b, grid, ranks, e);
+    if (!e.ready || b.reaction_nodes_move()) owned_nodes(b, grid, ranks, e);
     before_.resize(e.nodes.size() * size_t(kValues));
     for (int k = 0; k < u.count; ++k)
       for (size_t j = 0; j < e.nodes.size(); ++j)
@@ -84,7 +84,7 @@ class Reactions {
   /// damping's force, left out of the reactions).
   void before_damping(const NodalVector& force, const Grid<D>& grid, const Ranks<D>& ranks) {
     for (auto& [b, e] : entries_) {
-      if (!e.ready) owned_nodes(*b, grid, ranks, e);
+      if (!e.ready || b->reaction_nodes_move()) owned_nodes(*b, grid, ranks, e);
       e.damping.resize(e.nodes.size() * D);
       for (size_t j = 0; j < e.nodes.size(); ++j)
         for (int d = 0; d < D; ++d) e.damping[j * D + size_t(d)] = -force.at(e.nodes[j], d);
@@ -141,6 +141,7 @@ class Reactions {
   /// The nodes of b this rank owns (each node counted on one rank), once its nodes are set up.
   static void owned_nodes(const Boundary<D>& b, const Grid<D>& grid, const Ranks<D>& ranks,
                           Entry& e) {
+    e.nodes.clear();
     for (size_t n : *b.reaction_nodes())
       if (ranks.owns_node(grid, grid.node_ijk(n))) e.nodes.push_back(n);
     e.ready = true;

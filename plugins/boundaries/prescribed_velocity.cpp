@@ -63,19 +63,7 @@ class PrescribedVelocity : public Boundary<D> {
   void constrain_grid_update(const GridUpdate& u) const override {
     const double f = f_.value(u.time);
     for (int d = 0; d < D; ++d) now_[size_t(d)] = v_[size_t(d)] * f;
-    for (int k = 0; k < u.count; ++k) {
-      if (!applies_to(k)) continue;
-      const PhaseUpdate& p = u.phases[size_t(k)];
-      for (size_t n : nodes_) {
-        if (!(p.mass.at(n, 0) > 0)) continue;
-        for (int d : dirs_) {
-          const double before = p.velocity.at(n, d);
-          p.velocity.at(n, d) = now_[size_t(d)];
-          if (u.dt > 0) p.acceleration.at(n, d) += (now_[size_t(d)] - before) / u.dt;
-          if (u.held[size_t(k)]) u.held[size_t(k)]->hold(n, d);
-        }
-      }
-    }
+    impose_velocity<D>(u, nodes_, dirs_, now_, [&](int k) { return applies_to(k); });
   }
   /// The MUSL re-mapped velocities (the only other vectors the schemes constrain).
   void constrain(const NodalVector& v) const override {

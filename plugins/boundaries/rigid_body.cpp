@@ -1,0 +1,134 @@
+// A rigid body with a prescribed motion: the particles of a body (`body`) impose the body's
+// velocity v f(t) (f its time function of the loads' time, absent: 1) on every grid node they
+// touch, in the components `directions` (default: all, a rough contact bonded to the soil; [y]
+// for a footing smooth along x). Every node of such a particle's stencil then moves at v, so the
+// particle moves at v and its velocity gradient sum_I v grad N_I is zero (partition of unity):
+// the body translates without strain, as one piece. Unlike a prescribed_velocity box, whose
+// nodes stay where they are in space, the held nodes follow the body: a footing stays in contact
+// with the soil it pushes down, a pile or a cone goes on into the ground, a wall translates.
+// The nodes are found each step when the forces are gathered (add_forces: before damping and
+// the boundary passes), from the body's particles at x^n and the shape function's stencil. Its
+// reaction (framework/reactions.hpp; `name`, default rigid_body_<position>) is the force on the
+// soil, the body's weight under gravity and its inertia m dv/dt (zero at a constant velocity);
+// a probe on one of its
+// particles (particle_near, fields [displacement]) gives its displacement.
+// Limits: translation only; the contact is bonded (no separation, no Coulomb sliding: issue 42's
+// contact); the body's material is not used but in the time step (its wave speed counts: give the
+// soil's stiffness, not steel's); serial runs only.
+#include <algorithm>
+
+#include "framework/load_time.hpp"
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+
+namespace loam {
+
+template <int D>
+class RigidBody : public Boundary<D> {
+ public:
+  static constexpr const char* name = "rigid_body";
+  static constexpr const char* summary =
+      "a body's particles impose a prescribed velocity on the nodes they touch: a rigid "
+      "footing, pile or wall that moves with its particles";
+  static Schema schema() {
+    Schema s;
+    add_reaction_name(s);
+    s.text("body", "the body that moves rigidly (its particles)").required();
+    s.vector("velocity", "m/s", "the body's velocity (components in `directions`)").required();
+    s.string_list("directions",
+                  "components imposed on the nodes (x, y, z); default all (bonded contact)");
+    s.plugin("time_function", "time_function",
+             "factor f(t) on the velocity over the loads' time (absent: 1)");
+    add_phase_param(s);
+    return s;
+  }
+  explicit RigidBody(const Params& p)
+      : params_(p), body_name_(p.text("body")), phases_(parse_phase_mask(p)), f_(p) {
+    for (int d = 0; d < D; ++d) v_[size_t(d)] = p.vec("velocity")[size_t(d)];
+  }
+  bool applies_to(int phase) const override { return (phases_ >> phase) & 1; }
+
+  void setup(Simulation<D>& sim, Diagnostics& diag) override {
+    check_phase_mask(phases_, sim.scheme->phases(), params_, diag);
+    if (!params_.has("directions")) {
+      for (int d = 0; d < D; ++d) dirs_.push_back(d);
+    } else {
+      for (const auto& name : params_.strings("directions")) {
+        const auto at = std::string("xyz").find(name);
+        if (name.size() != 1 || at == std::string::npos || int(at) >= D)
+          diag.error(params_.where("directions"), params_.path("directions"),
+                     "unknown direction '" + name + "' (x, y" + (D == 3 ? ", z" : "") + ")");
+        else
+          dirs_.push_back(int(at));
+      }
+    }
+    body_ = sim.body_index(body_name_);
+    if (body_ < 0)
+      return sim.unknown_body(diag, params_.where("body"), params_.path("body"), body_name_);
+    set_ = sim.body_set(body_);
+    sim_ = &sim;
+    stencil_.allocate(sim.shape->max_nodes_per_particle());
+    touched_.assign(sim.grid.num_nodes, 0);
+  }
+
+  /// The nodes the body's particles touch this step (their stencils' nodes with a weight).
+  void add_forces(const GridForces&) const override { find_nodes(); }
+
+  void constrain_grid_update(const GridUpdate& u) const override {
+    const double f = f_.value(u.time);
+    for (int d = 0; d < D; ++d) now_[size_t(d)] = v_[size_t(d)] * f;
+    impose_velocity<D>(u, nodes_, dirs_, now_, [&](int k) { return applies_to(k); });
+  }
+  /// The MUSL re-mapped velocities.
+  void constrain(const NodalVector& v) const override {
+    for (size_t n : nodes_)
+      for (int d : dirs_) v.at(n, d) = now_[size_t(d)];
+  }
+  void mark_held(HeldComponents& held) const override {
+    for (size_t n : nodes_)
+      for (int d : dirs_) held.hold(n, d);
+  }
+  const std::vector<size_t>* reaction_nodes() const override { return &nodes_; }
+  bool reaction_nodes_move() const override { return true; }
+
+ private:
+  /// Blocks of the body's set that hold a particle of the body are evaluated (the set is sorted
+  /// by cell, so the body's particles fill few blocks); every node with a weight is kept once.
+  void find_nodes() const {
+    for (size_t n : nodes_) touched_[n] = 0;
+    nodes_.clear();
+    const Particles<D>& P = sim_->sets[size_t(set_)].particles;
+    for (size_t b = 0; b < P.size(); b += kBlock) {
+      const int count = int(std::min<size_t>(kBlock, P.size() - b));
+      bool mine = false;
+      for (int p = 0; p < count && !mine; ++p) mine = P.body[b + size_t(p)] == body_;
+      if (!mine) continue;
+      sim_->shape->evaluate(sim_->grid, P, b, count, stencil_);
+      for (int p = 0; p < count; ++p) {
+        if (P.body[b + size_t(p)] != body_) continue;
+        for (int k = 0; k < stencil_.npp; ++k) {
+          const size_t kp = size_t(k) * kBlock + size_t(p);
+          const size_t n = size_t(stencil_.node[kp]);
+          if (stencil_.w[kp] > 0 && !touched_[n]) touched_[n] = 1, nodes_.push_back(n);
+        }
+      }
+    }
+  }
+
+  Params params_;
+  std::string body_name_;
+  int phases_;
+  TimeFactor<D> f_;
+  std::array<double, D> v_{};
+  std::vector<int> dirs_;
+  int body_ = -1, set_ = 0;
+  const Simulation<D>* sim_ = nullptr;
+  mutable StencilBlock<D> stencil_;
+  mutable std::vector<uint8_t> touched_;
+  mutable std::vector<size_t> nodes_;    // the nodes the body touches this step
+  mutable std::array<double, D> now_{};  // velocity of the current step
+};
+
+LOAM_REGISTER(Boundary, RigidBody)
+
+}  // namespace loam
