@@ -1,25 +1,25 @@
 #pragma once
 // The reaction of each mechanical boundary condition: the force it applies on the model in a
-// step, per phase, measured where it acts, in the grid update (Simulation::constrain_update).
-// A condition changes the nodal velocity v^{n+1} = v^n + dt a of its nodes and keeps the
-// acceleration consistent with it, so the force it adds is
-//   R = sum over its nodes of m (a_after - a_before) = sum m (v_held - v_free) / dt,
-// the momentum it takes or gives per unit time: a fixed base under a column at rest carries
-// the column's weight, a footing pushed by prescribed_velocity the soil's resistance (with the
-// sign of the force on the model: a base holding a column up reports +W along the vertical).
-// It covers the kinematic pass (holds, dashpots, unilateral contact) and the Coulomb pass
-// (friction). Local damping changes the nodal forces before the conditions act (Cundall's
-// f -= alpha |f| sign(v), with v a node's round-off velocity on a held face): that change is
-// no force of the model's, so at the components a condition changes the damping's force is
-// added back, and the reaction is the force the model's stresses, weight and loads put on
-// the support (R = -f there), whatever the damping. Where several conditions share a node (an edge,
-// a corner), the change is credited to the one that makes it, in the config's order; their sum is
-// the node's whole reaction. Under mpirun each rank sums the nodes it owns, the step's values are
-// summed over the ranks. Hydraulic conditions (a force on the water, Boundary::add_forces) and
-// periodic faces report none.
+// step, per phase. The conditions change the nodal velocity v^{n+1} = v^n + dt a of their nodes
+// and keep the acceleration consistent with it, so the force on a node is m (a_after -
+// a_before), taken over the whole constraint stage of the grid update (Simulation::
+// constrain_update): the kinematic and Coulomb passes, the hydraulic conditions on the water
+// (a drained face that releases the water a fixed face held leaves no water force; an
+// impermeable one that holds it adds one) and a two-phase scheme's re-solve of a free phase
+// against a held one (the drag the held phase then carries). Each node is credited to the first
+// condition in the list that names it (list a wall before the base to give it the corner).
+// A fixed base under a column at rest carries its weight, a footing pushed by a prescribed
+// velocity the soil's resistance (the sign is the force on the model: a base holding a column up
+// reports +W along the vertical). Face forces a condition adds itself (Boundary::add_forces, an
+// absorbing face's free-field reaction) are measured around that call. Local damping changes
+// the nodal forces before the conditions act (Cundall's f -= alpha |f| sign(v), v a held node's
+// round-off velocity): at a component held at the end its force is added back, so the reaction
+// is what the stresses, weight and loads put on the support, whatever the damping. Under mpirun
+// each rank sums the nodes it owns and the step's values are summed over the ranks.
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <memory>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -42,7 +42,7 @@ class Reactions {
     const auto it = std::find(names_.begin(), names_.end(), name);
     const int slot = int(it - names_.begin());
     if (it == names_.end()) names_.push_back(name);
-    entries_[b] = Entry{slot, {}, {}, false};
+    entries_[b] = Entry{slot, {}, false};
     step_.assign(names_.size() * kValues, 0.0);
     low_.assign(step_.size(), std::numeric_limits<double>::infinity());
     high_.assign(step_.size(), -std::numeric_limits<double>::infinity());
@@ -50,50 +50,89 @@ class Reactions {
   const std::vector<std::string>& names() const { return names_; }
   bool empty() const { return names_.empty(); }
 
-  /// Run `act` (b's part of the grid update u) and add the force it applied at b's nodes.
+  /// Before the boundary passes of a step: the nodes each active condition reports (a node
+  /// named by several conditions goes to the first in the list) and their accelerations.
+  void begin_update(const std::vector<std::unique_ptr<Boundary<D>>>& active, const GridUpdate& u,
+                    const Grid<D>& grid, const Ranks<D>& ranks) {
+    if (owner_.size() != grid.num_nodes) owner_.assign(grid.num_nodes, -1);
+    claimed_.clear();
+    for (const auto& b : active) {
+      const auto it = entries_.find(b.get());
+      if (it == entries_.end()) continue;
+      Entry& e = it->second;
+      if (!e.ready || b->reaction_nodes_move()) owned_nodes(*b, grid, ranks, e);
+      for (size_t n : e.nodes)
+        if (owner_[n] < 0) owner_[n] = e.slot, claimed_.push_back(n);
+    }
+    before_.resize(claimed_.size() * size_t(kValues));
+    for (int k = 0; k < u.count; ++k)
+      for (size_t j = 0; j < claimed_.size(); ++j)
+        for (int d = 0; d < D; ++d)
+          before_[(j * 2 + size_t(k)) * D + size_t(d)] =
+              u.phases[size_t(k)].acceleration.at(claimed_[j], d);
+  }
+  /// After every pass (hydraulic conditions and a two-phase scheme's re-solve of a free phase
+  /// against a held one included): m (a_after - a_before) per node and phase to its
+  /// condition, and the damping's force at the components held at the end.
+  void end_update(const GridUpdate& u) {
+    for (int k = 0; k < u.count; ++k)
+      for (size_t j = 0; j < claimed_.size(); ++j) {
+        const size_t n = claimed_[j];
+        const PhaseUpdate& ph = u.phases[size_t(k)];
+        double* r = step_.data() + size_t(owner_[n]) * kValues + size_t(k * D);
+        for (int d = 0; d < D; ++d) {
+          const double da = ph.acceleration.at(n, d) - before_[(j * 2 + size_t(k)) * D + size_t(d)];
+          r[d] += ph.mass.at(n, 0) * da;
+          const bool held = u.held[size_t(k)] && u.held[size_t(k)]->held(n, d);
+          if (k == 0 && damped_ && held && da != 0) r[d] += damping_[n * D + size_t(d)];
+        }
+      }
+    for (size_t n : claimed_) owner_[n] = -1;
+  }
+
+  /// Face forces (Boundary::add_forces, e.g. an absorbing face's free-field reaction): the
+  /// change `act` makes at b's nodes, the mixture (or only) force to phase 0, the water's to 1.
   template <class F>
-  void measure(const Boundary<D>& b, const GridUpdate& u, const Grid<D>& grid,
-               const Ranks<D>& ranks, F&& act) {
+  void measure_forces(const Boundary<D>& b, const GridForces& f, const Grid<D>& grid,
+                      const Ranks<D>& ranks, F&& act) {
     const auto it = entries_.find(&b);
     if (it == entries_.end()) return act();
     Entry& e = it->second;
     if (!e.ready || b.reaction_nodes_move()) owned_nodes(b, grid, ranks, e);
+    const NodalVector* v[2] = {&f.mixture, &f.water};
     before_.resize(e.nodes.size() * size_t(kValues));
-    for (int k = 0; k < u.count; ++k)
+    for (int k = 0; k < f.count; ++k)
       for (size_t j = 0; j < e.nodes.size(); ++j)
         for (int d = 0; d < D; ++d)
-          before_[(j * 2 + size_t(k)) * D + size_t(d)] =
-              u.phases[size_t(k)].acceleration.at(e.nodes[j], d);
+          before_[(j * 2 + size_t(k)) * D + size_t(d)] = v[k]->at(e.nodes[j], d);
     act();
     double* r = step_.data() + size_t(e.slot) * kValues;
-    for (int k = 0; k < u.count; ++k)
-      for (size_t j = 0; j < e.nodes.size(); ++j) {
-        const PhaseUpdate& ph = u.phases[size_t(k)];
-        const double m = ph.mass.at(e.nodes[j], 0);
-        for (int d = 0; d < D; ++d) {
-          const double da =
-              ph.acceleration.at(e.nodes[j], d) - before_[(j * 2 + size_t(k)) * D + size_t(d)];
-          r[k * D + d] += m * da;
-          if (k == 0 && damped_ && da != 0) r[d] += e.damping[j * D + size_t(d)];
-        }
-      }
+    for (int k = 0; k < f.count; ++k)
+      for (size_t j = 0; j < e.nodes.size(); ++j)
+        for (int d = 0; d < D; ++d)
+          r[k * D + d] += v[k]->at(e.nodes[j], d) - before_[(j * 2 + size_t(k)) * D + size_t(d)];
   }
 
-  /// Local damping acts on the nodal forces of phase 0 (the only phase or the skeleton):
-  /// the forces at every reporting node before it, then after it (their difference is the
-  /// damping's force, left out of the reactions).
+  /// Local damping acts on the nodal forces of phase 0 (the only phase or the skeleton): the
+  /// forces at every reporting node before it, then after it (their difference is the
+  /// damping's force, left out of the reactions where a condition holds the component).
   void before_damping(const NodalVector& force, const Grid<D>& grid, const Ranks<D>& ranks) {
+    if (damping_.size() != grid.num_nodes * D) damping_.assign(grid.num_nodes * D, 0.0);
+    if (owner_.size() != grid.num_nodes) owner_.assign(grid.num_nodes, -1);
+    damped_nodes_.clear();
     for (auto& [b, e] : entries_) {
       if (!e.ready || b->reaction_nodes_move()) owned_nodes(*b, grid, ranks, e);
-      e.damping.resize(e.nodes.size() * D);
-      for (size_t j = 0; j < e.nodes.size(); ++j)
-        for (int d = 0; d < D; ++d) e.damping[j * D + size_t(d)] = -force.at(e.nodes[j], d);
+      for (size_t n : e.nodes)
+        if (owner_[n] != -2) owner_[n] = -2, damped_nodes_.push_back(n);  // each node once
+    }
+    for (size_t n : damped_nodes_) {
+      owner_[n] = -1;
+      for (int d = 0; d < D; ++d) damping_[n * D + size_t(d)] = -force.at(n, d);
     }
   }
   void after_damping(const NodalVector& force) {
-    for (auto& [b, e] : entries_)
-      for (size_t j = 0; j < e.nodes.size(); ++j)
-        for (int d = 0; d < D; ++d) e.damping[j * D + size_t(d)] += force.at(e.nodes[j], d);
+    for (size_t n : damped_nodes_)
+      for (int d = 0; d < D; ++d) damping_[n * D + size_t(d)] += force.at(n, d);
     damped_ = true;
   }
 
@@ -134,8 +173,7 @@ class Reactions {
  private:
   struct Entry {
     int slot = -1;
-    std::vector<size_t> nodes;    // the condition's nodes this rank owns
-    std::vector<double> damping;  // per node and component: the damping's force of the step
+    std::vector<size_t> nodes;  // the condition's nodes this rank owns
     bool ready = false;
   };
   /// The nodes of b this rank owns (each node counted on one rank), once its nodes are set up.
@@ -149,7 +187,12 @@ class Reactions {
   std::vector<std::string> names_;
   std::unordered_map<const Boundary<D>*, Entry> entries_;
   std::vector<double> step_, low_, high_, before_;
-  bool damped_ = false;  // damping acted in this step (the entries' damping is its force)
+  std::vector<int> owner_;       // per grid node: the column it is credited to this step, or -1
+  std::vector<size_t> claimed_;  // the nodes credited this step
+  std::vector<double>
+      damping_;  // per grid node and component: the damping's force (reporting nodes)
+  std::vector<size_t> damped_nodes_;  // the reporting nodes, each once, where damping_ is set
+  bool damped_ = false;               // damping acted in this step
 };
 
 }  // namespace loam

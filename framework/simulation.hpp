@@ -151,9 +151,16 @@ class Simulation {
   ///     holds at the node (Bardenhagen et al. 2000: normal constraint, then the Coulomb impulse
   ///     in the remaining free subspace; several friction faces scale the same free vector, so
   ///     their order does not matter either);
-  ///  4. the hydraulic conditions on the water.
-  /// Each mechanical condition's reaction is measured around its passes (reactions).
+  ///  4. the hydraulic conditions on the water;
+  ///  5. `coupling`: what a scheme does at once with the conditions' result (two-phase: the
+  ///     re-solve of a free phase against a held one, follow_held_phases).
+  /// The reactions (framework/reactions.hpp) are the change of all of it at the mechanical
+  /// conditions' nodes.
   void constrain_update(const GridUpdate& update) {
+    constrain_update(update, [] {});
+  }
+  template <class F>
+  void constrain_update(const GridUpdate& update, F&& coupling) {
     GridUpdate u = update;
     u.time = time - loads_start;
     for (int k = 0; k < u.count; ++k) {
@@ -163,13 +170,15 @@ class Simulation {
     for (int pass = 0; pass < 2; ++pass)
       for (const auto& b : boundaries)
         if (b->hydraulic() == (pass == 0)) b->before_constraints(u);
+    if (!reactions.empty()) reactions.begin_update(boundaries, u, grid, *ranks);
     for (const auto& b : boundaries)
-      if (!b->hydraulic())
-        reactions.measure(*b, u, grid, *ranks, [&] { b->constrain_grid_update(u); });
+      if (!b->hydraulic()) b->constrain_grid_update(u);
     for (const auto& b : boundaries)
-      if (!b->hydraulic()) reactions.measure(*b, u, grid, *ranks, [&] { b->coulomb_update(u); });
+      if (!b->hydraulic()) b->coulomb_update(u);
     for (const auto& b : boundaries)
       if (b->hydraulic()) b->constrain_grid_update(u);
+    coupling();
+    if (!reactions.empty()) reactions.end_update(u);
     timed("check_grid", [&] { check_grid(u); });
   }
   /// NaN or inf on the grid is caught in the step it appears (before the transfer to the
@@ -212,9 +221,10 @@ class Simulation {
     materials[set.particles.material[b]]->update_stress(batch);
   }
   /// Face forces of the boundary conditions (GridForces), before the grid update.
-  void apply_boundary_forces(GridForces f) const {
+  void apply_boundary_forces(GridForces f) {
     f.time = time - loads_start;
-    for (const auto& b : boundaries) b->add_forces(f);
+    for (const auto& b : boundaries)
+      reactions.measure_forces(*b, f, grid, *ranks, [&] { b->add_forces(f); });
   }
   void apply_grid_loads(const NodalVector& force) {
     for (const auto& l : loads) l->apply_to_grid(*this, force, time - loads_start);

@@ -100,9 +100,10 @@ void constrain_two_phase_update(Simulation<D>& sim, double* records, const TwoPh
   u.count = 2;
   u.dt = dt;
   u.porosity = NodalVector{records, S, k.porosity};
-  sim.constrain_update(u);
-  follow_held_phases<D>(records, k, solved, sim.grid.num_nodes, sim.threads, sim.mass_tolerance,
-                        dt);
+  sim.constrain_update(u, [&] {
+    follow_held_phases<D>(records, k, solved, sim.grid.num_nodes, sim.threads, sim.mass_tolerance,
+                          dt);
+  });
 }
 
 /// Square of the fastest wave speed of the undamped (drag-free) two-phase equations: the largest

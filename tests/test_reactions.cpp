@@ -135,7 +135,8 @@ TEST_CASE("reactions: history.csv and summary.json carry each condition's force 
   yaml.replace(yaml.find(base), base.size(), "  - {type: fixed, face: y-, name: base}");
   yaml.replace(yaml.find("time: {end: 0.5}"), 16,
                "time: {end: 0.05}\noutput: {every_time: 1, history_every: 1, history_digits: 17}\n"
-               "probes: [{name: top, node_near: [0.49, 10.1], fields: [velocity]}]");
+               "probes: [{name: top, node_near: [0.49, 10.1], fields: [velocity, mass]},\n"
+               "         {name: node, node: [2, 40], fields: [velocity, mass]}]");
   const auto r = loam_test::run_yaml(dir.path, yaml);
   REQUIRE(r.exit_code == 0);
   const auto h = loam_test::read_csv_columns(dir.path / "out" / "history.csv");
@@ -154,9 +155,13 @@ TEST_CASE("reactions: history.csv and summary.json carry each condition's force 
   CHECK(last == Approx(y.back()).epsilon(1e-14));
   CHECK(lo == Approx(rows_lo).epsilon(1e-14));
   CHECK(hi == Approx(rows_hi).epsilon(1e-14));
-  // node_near [0.49, 10.1] is node (2, 40) of the 0.25 m grid: its probe has the node's columns.
+  // node_near [0.49, 10.1] is node (2, 40) of the 0.25 m grid: its rows are the node probe's.
   const auto p = loam_test::read_csv_columns(dir.path / "out" / "probe_top.csv");
-  CHECK(p.count("velocity_x") == 1);
+  const auto q = loam_test::read_csv_columns(dir.path / "out" / "probe_node.csv");
+  REQUIRE(p.count("mass") == 1);
+  CHECK(p.at("mass") == q.at("mass"));
+  CHECK(p.at("velocity_y") == q.at("velocity_y"));
+  CHECK(p.at("mass").back() > 0);
 }
 
 TEST_CASE("reactions: a name given twice and a node_near outside the grid are located errors",

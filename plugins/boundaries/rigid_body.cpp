@@ -1,9 +1,11 @@
 // A rigid body with a prescribed motion: the particles of a body (`body`) impose the body's
 // velocity v f(t) (f its time function of the loads' time, absent: 1) on every grid node they
-// touch, in the components `directions` (default: all, a rough contact bonded to the soil; [y]
-// for a footing smooth along x). Every node of such a particle's stencil then moves at v, so the
-// particle moves at v and its velocity gradient sum_I v grad N_I is zero (partition of unity):
-// the body translates without strain, as one piece. Unlike a prescribed_velocity box, whose
+// touch, in the components `directions` (default: all, a rough contact bonded to the soil).
+// Every node of such a particle's stencil then moves at v, so the particle moves at v and its
+// velocity gradient sum_I v grad N_I is zero (partition of unity): the body translates without
+// strain, as one piece. With some directions only (e.g. [y], a footing smooth along x) the free
+// components follow the grid like any particle's: the body is rigid only in the imposed ones
+// and strains in the others (its material then acts). Unlike a prescribed_velocity box, whose
 // nodes stay where they are in space, the held nodes follow the body: a footing stays in contact
 // with the soil it pushes down, a pile or a cone goes on into the ground, a wall translates.
 // The nodes are found each step when the forces are gathered (add_forces: before damping and
@@ -72,15 +74,16 @@ class RigidBody : public Boundary<D> {
   }
 
   /// The nodes the body's particles touch this step (their stencils' nodes with a weight).
-  void add_forces(const GridForces&) const override { find_nodes(); }
+  void add_forces(const GridForces&) const override { refresh(); }
 
   void constrain_grid_update(const GridUpdate& u) const override {
-    const double f = f_.value(u.time);
-    for (int d = 0; d < D; ++d) now_[size_t(d)] = v_[size_t(d)] * f;
+    refresh();
     impose_velocity<D>(u, nodes_, dirs_, now_, [&](int k) { return applies_to(k); });
   }
-  /// The MUSL re-mapped velocities.
+  /// The MUSL re-mapped velocities, and USF's velocities before the grid update (the first
+  /// call of a step finds the step's nodes).
   void constrain(const NodalVector& v) const override {
+    refresh();
     for (size_t n : nodes_)
       for (int d : dirs_) v.at(n, d) = now_[size_t(d)];
   }
@@ -92,6 +95,14 @@ class RigidBody : public Boundary<D> {
   bool reaction_nodes_move() const override { return true; }
 
  private:
+  /// The step's nodes and velocity, once per step (whichever call of the step comes first).
+  void refresh() const {
+    if (refreshed_ == sim_->step) return;
+    refreshed_ = sim_->step;
+    const double f = f_.value(sim_->time - sim_->loads_start);
+    for (int d = 0; d < D; ++d) now_[size_t(d)] = v_[size_t(d)] * f;
+    find_nodes();
+  }
   /// Blocks of the body's set that hold a particle of the body are evaluated (the set is sorted
   /// by cell, so the body's particles fill few blocks); every node with a weight is kept once.
   void find_nodes() const {
@@ -127,6 +138,7 @@ class RigidBody : public Boundary<D> {
   mutable std::vector<uint8_t> touched_;
   mutable std::vector<size_t> nodes_;    // the nodes the body touches this step
   mutable std::array<double, D> now_{};  // velocity of the current step
+  mutable long refreshed_ = -2;          // the step whose nodes and velocity these are
 };
 
 LOAM_REGISTER(Boundary, RigidBody)
