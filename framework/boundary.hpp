@@ -194,6 +194,20 @@ void impose_velocity(const GridUpdate& u, const std::vector<size_t>& nodes,
   }
 }
 
+/// Components `dirs` of `nodes` set to `value` in a single nodal vector (the MUSL re-mapped
+/// velocities), and marked held for the Coulomb pass (prescribed_velocity, rigid_body, slip).
+template <int D>
+void set_components(const NodalVector& v, const std::vector<size_t>& nodes,
+                    const std::vector<int>& dirs, const std::array<double, D>& value) {
+  for (size_t n : nodes)
+    for (int d : dirs) v.at(n, d) = value[size_t(d)];
+}
+inline void hold_components(HeldComponents& held, const std::vector<size_t>& nodes,
+                            const std::vector<int>& dirs) {
+  for (size_t n : nodes)
+    for (int d : dirs) held.hold(n, d);
+}
+
 /// The nodes on one face of the grid ("x-", "x+", "y-", ...), for face-based plugins.
 struct Face {
   int axis = 0;

@@ -1126,14 +1126,14 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       const bool surface = cells_.weight(c) < filling * cell_porosity(c) / inv_cell_volume_;
       flag[i] = surface ? 1.0 : 0.0;
       const double share = water_share(saturation[i]);
-      const double v0 = m[i] / sim.materials[P.material[size_t(i)]]->density();  // at p = 0
+      auto free_volume = [&] { return m[i] / sim.materials[P.material[size_t(i)]]->density(); };
       if (surface && zero_surface_pressure_)
-        V[i] = v0;
+        V[i] = free_volume();
       else if (smooth_ && degree == CellPressure::kConstant)
         V[i] = m[i] * cells_.weight(c) / cells_.weighted_value(c);
       else if (smooth_)
         V[i] = m[i] / cells_.at(sim.grid, P, size_t(i));
-      if (share < 1) V[i] = std::min(V[i], v0);  // no suction in partly filled pores
+      if (share < 1) V[i] = std::min(V[i], free_volume());  // no suction in partly filled pores
     }
   }
 

@@ -66,14 +66,8 @@ class PrescribedVelocity : public Boundary<D> {
     impose_velocity<D>(u, nodes_, dirs_, now_, [&](int k) { return applies_to(k); });
   }
   /// The MUSL re-mapped velocities (the only other vectors the schemes constrain).
-  void constrain(const NodalVector& v) const override {
-    for (size_t n : nodes_)
-      for (int d : dirs_) v.at(n, d) = now_[size_t(d)];
-  }
-  void mark_held(HeldComponents& held) const override {
-    for (size_t n : nodes_)
-      for (int d : dirs_) held.hold(n, d);
-  }
+  void constrain(const NodalVector& v) const override { set_components<D>(v, nodes_, dirs_, now_); }
+  void mark_held(HeldComponents& held) const override { hold_components(held, nodes_, dirs_); }
 
   const std::vector<size_t>* reaction_nodes() const override { return &nodes_; }
 

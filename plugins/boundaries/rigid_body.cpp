@@ -12,11 +12,10 @@
 // the boundary passes), from the body's particles at x^n and the shape function's stencil. Its
 // reaction (framework/reactions.hpp; `name`, default rigid_body_<position>) is the force on the
 // soil, the body's weight under gravity and its inertia m dv/dt (zero at a constant velocity);
-// a probe on one of its
-// particles (particle_near, fields [displacement]) gives its displacement.
-// Limits: translation only; the contact is bonded (no separation, no Coulomb sliding: issue 42's
-// contact); the body's material is not used but in the time step (its wave speed counts: give the
-// soil's stiffness, not steel's); serial runs only.
+// a probe on one of its particles (particle_near, fields [displacement]) gives its displacement.
+// Limits: translation only; the contact is bonded (no separation, no Coulomb sliding between
+// the body and the soil); the body's material is not used but in the time step (its wave speed
+// counts: give the soil's stiffness, not steel's); serial runs only.
 #include <algorithm>
 
 #include "framework/load_time.hpp"
@@ -84,13 +83,9 @@ class RigidBody : public Boundary<D> {
   /// call of a step finds the step's nodes).
   void constrain(const NodalVector& v) const override {
     refresh();
-    for (size_t n : nodes_)
-      for (int d : dirs_) v.at(n, d) = now_[size_t(d)];
+    set_components<D>(v, nodes_, dirs_, now_);
   }
-  void mark_held(HeldComponents& held) const override {
-    for (size_t n : nodes_)
-      for (int d : dirs_) held.hold(n, d);
-  }
+  void mark_held(HeldComponents& held) const override { hold_components(held, nodes_, dirs_); }
   const std::vector<size_t>* reaction_nodes() const override { return &nodes_; }
   bool reaction_nodes_move() const override { return true; }
 

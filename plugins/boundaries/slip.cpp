@@ -49,10 +49,7 @@ class Slip : public Boundary<D> {
     for (size_t n : nodes_)
       for (int d : fixed_) v.at(n, d) = 0.0;
   }
-  void mark_held(HeldComponents& held) const override {
-    for (size_t n : nodes_)
-      for (int d : fixed_) held.hold(n, d);
-  }
+  void mark_held(HeldComponents& held) const override { hold_components(held, nodes_, fixed_); }
   /// Only if the solid's normal is among the fixed directions (`directions: [y]` on x- holds a
   /// tangential component: the particles may leave through x-).
   int holds_face(int phase) const override {
