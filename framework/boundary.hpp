@@ -103,6 +103,10 @@ class Boundary {
   virtual bool runs_on_ranks() const { return false; }
   /// Add face forces to the nodal forces of a step, before the grid update (default: none).
   virtual void add_forces(const GridForces&) const {}
+  /// Whether add_forces adds forces (rather than none, or joining nodes): their work then goes
+  /// to the energy balance (framework/energy_ledger.hpp), which records the nodal forces around
+  /// the call.
+  virtual bool adds_forces() const { return false; }
   /// Checkpoints (output.checkpoint): a condition's state measured during the run (e.g. the
   /// reaction an absorbing face took over at its first step), appended as doubles and restored
   /// bit for bit on --resume. false (default): it has none.

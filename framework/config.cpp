@@ -258,6 +258,12 @@ Schema config_schema() {
               "write energies and momentum to history.csv every N steps (0: at frames)")
         .def("0")
         .min(0);
+    o.boolean("energy_balance",
+              "add the energy balance to history.csv and summary.json: material, damping and "
+              "transfer dissipation, the work of loads and boundary conditions, the energy "
+              "particles carry in and out, and the balance (docs/energy_balance.md; costs a few "
+              "% of the step)")
+        .def("false");
     o.integer("history_digits",
               "significant digits of the numbers in history.csv (17: every bit of a double)")
         .def("12")

@@ -21,6 +21,9 @@ class Load {
   virtual void apply_to_grid(Simulation<D>&, const NodalVector& /*force*/, double /*t*/) {}
   /// Whether this load writes particle external forces (the field is allocated only then).
   virtual bool uses_particle_forces() const { return false; }
+  /// Whether apply_to_grid adds nodal forces: their work then goes to the energy balance
+  /// (framework/energy_ledger.hpp), which records the nodal forces around the call.
+  virtual bool uses_grid_forces() const { return false; }
   /// Whether it runs on a grid split over MPI ranks (docs/parallel.md): it reads and writes only
   /// the particles of this rank and the stored box of nodes, each node as the whole grid's
   /// value. Default false: a run under mpirun refuses it with a located error.

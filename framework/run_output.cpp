@@ -257,6 +257,10 @@ void Run<D>::open_outputs(long resume_step) {
     history_.out() << ",momentum_"
                    << "xyz"[d];
   if (exchanges_particles()) history_.out() << ",particles,mass_created,mass_removed";
+  if (sim_->ledger.enabled)
+    history_.out() << ",dissipation_material,dissipation_damping,dissipation_transfer,dissipation_"
+                      "drag,work_loads,"
+                      "work_boundaries,energy_carried,energy_balance";
   for (const auto& name : sim_->reactions.names())
     for (int k = 0; k < sim_->scheme->phases(); ++k)
       for (int d = 0; d < D; ++d)
@@ -364,6 +368,8 @@ void Run<D>::write_history() {
   // Particles and the mass created and removed so far, over the ranks.
   double exchanged[3] = {double(sim_->num_particles()), sim_->mass_created, sim_->mass_removed};
   if (exchanges_particles()) sim_->ranks->sum(exchanged, 3);
+  EnergyBalance b;
+  if (sim_->ledger.enabled) b = energy_balance(e, ls_.e0, sim_->ledger.global(*sim_->ranks));
   if (!sim_->ranks->root()) return;
   auto& o = history_.out();
   double strain = std::isnan(e.strain) ? 0.0 : e.strain;
@@ -372,6 +378,10 @@ void Run<D>::write_history() {
   for (double m : e.momentum) o << "," << m;
   if (exchanges_particles())
     o << "," << size_t(exchanged[0]) << "," << exchanged[1] << "," << exchanged[2];
+  if (sim_->ledger.enabled)
+    for (double x :
+         {b.material, b.damping, b.transfer, b.drag, b.loads, b.boundaries, b.carried, b.balance})
+      o << "," << x;
   const Reactions<D>& r = sim_->reactions;
   for (size_t c = 0; c < r.names().size(); ++c)
     for (int k = 0; k < sim_->scheme->phases(); ++k)

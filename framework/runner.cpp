@@ -89,6 +89,18 @@ nlohmann::json energy_json(const Energies& e) {
       {"momentum", e.momentum}};
 }
 
+nlohmann::json balance_json(const EnergyBalance& b) {
+  return nlohmann::json{{"dissipation_material", b.material},
+                        {"dissipation_damping", b.damping},
+                        {"dissipation_transfer", b.transfer},
+                        {"dissipation_drag", b.drag},
+                        {"work_loads", b.loads},
+                        {"work_boundaries", b.boundaries},
+                        {"energy_carried", b.carried},
+                        {"balance", b.balance},
+                        {"largest_term", b.largest}};
+}
+
 }  // namespace
 
 namespace detail {
@@ -230,6 +242,7 @@ typename Run<D>::CheckpointImage Run<D>::checkpoint_image() {
     if (state.clear(), sim.boundaries[i]->save_state(state))
       image.plugins.emplace_back("plugin.boundary." + std::to_string(i), state);
   if (!sim.reactions.empty()) image.plugins.emplace_back("sim.reactions", sim.reactions.state());
+  if (sim.ledger.enabled) image.plugins.emplace_back("sim.energy_ledger", sim.ledger.state());
   return image;
 }
 
@@ -357,6 +370,7 @@ void Run<D>::restore_checkpoint() {
     if (probe.clear(), sim.boundaries[i]->save_state(probe))
       sim.boundaries[i]->restore_state(r.doubles("plugin.boundary." + std::to_string(i)));
   if (!sim.reactions.empty()) sim.reactions.restore(r.doubles("sim.reactions"));
+  if (sim.ledger.enabled) sim.ledger.restore(r.doubles("sim.energy_ledger"));
   // The checkpoints of the run so far, and none from beyond this one (that future is redone).
   for (const auto& file : checkpoint_files(dir_, sim.ranks->file_tag())) {
     if (checkpoint_step(file, sim.ranks->file_tag()) > sim.step) {
@@ -879,6 +893,9 @@ RunResult Run<D>::loop() {
                          {"balance", mass_now + mass_removed - mass_created - mass_initial}};
   res.summary["energy_initial"] = energy_json(ls_.e0);
   res.summary["energy_final"] = energy_json(e1);
+  if (sim.ledger.enabled)
+    res.summary["energy_balance"] =
+        balance_json(energy_balance(e1, ls_.e0, sim.ledger.global(*sim.ranks)));
   res.summary["verify"] = nlohmann::json::object();  // always there: empty without a reference
   if (sim.reference) {
     nlohmann::json v = nlohmann::json::object();

@@ -40,11 +40,18 @@ bool Simulation<D>::advance(double step_dt, bool check) {
   const bool track = checked && track_motion;
   if (track) timed("motion", [&] { keep_positions(); });
   reactions.begin_step();
+  if (ledger.enabled) {
+    std::vector<size_t> sizes;
+    for (const auto& s : sets) sizes.push_back(s.size());
+    ledger.begin_step(grid, *ranks, sizes);
+  }
+  const double load_moment = particle_load_moment();  // sum f . x^n
   scheme->step(*this, dt);
   time += dt;
   ++step;
   const bool distributed = ranks->distributed();
   reactions.end_step(*ranks);
+  ledger.end_step(*ranks, particle_load_moment() - load_moment);
   if (distributed) failure = ranks->first_message(failure);  // one rank's failure stops all
   if (!failure.empty()) return false;
   // The largest particle speed over the ranks: the time step's CFL bound is then the serial
@@ -226,6 +233,7 @@ void Simulation<D>::add_particles(int b, const std::vector<Vec>& x, const Vec& v
   materials[size_t(b)]->initialize(P, begin, end);
   restart_displacement(P, begin, end);
   for (size_t i = begin; i < end; ++i) mass_created += P.col(P.mass)[i];
+  carry_energy(P, begin, end, 1.0);
   created += kept.size();
   set.invalidate_index();
   set.resized = true;
@@ -249,6 +257,7 @@ void Simulation<D>::apply_sinks() {
     for (size_t i = 0; i < set.size(); ++i)
       if (remove[i]) mass_removed += m[i], ++n;
     if (n == 0) continue;
+    carry_energy(set.particles, 0, set.size(), -1.0, remove.data());
     set.particles.erase(remove);
     set.invalidate_index();
     set.resized = true;
@@ -261,6 +270,37 @@ double Simulation<D>::total_mass() const {
   double m = 0;
   for (const auto& set : sets) m += set.mass();
   return m;
+}
+
+template <int D>
+double Simulation<D>::particle_load_moment() const {
+  if (external_force < 0 || !ledger.enabled) return 0.0;
+  double sum = 0;
+  for (const auto& s : sets)
+    for (int d = 0; d < D; ++d) {
+      const double* f = s.particles.col(external_force, d);
+      const double* x = s.particles.col(s.particles.position, d);
+      for (size_t i = 0; i < s.size(); ++i) sum += f[i] * x[i];
+    }
+  return sum;
+}
+
+template <int D>
+void Simulation<D>::carry_energy(const Particles<D>& P, size_t begin, size_t end, double sign,
+                                 const uint8_t* only) {
+  if (!ledger.enabled) return;
+  auto& t = ledger.totals;
+  const double* m = P.col(P.mass);
+  for (size_t i = begin; i < end; ++i) {
+    if (only && !only[i]) continue;
+    for (int d = 0; d < D; ++d) {
+      const double v = P.col(P.velocity, d)[i];
+      t.carried_kinetic += sign * 0.5 * m[i] * v * v;
+      t.carried_gravity -= sign * m[i] * gravity[size_t(d)] * P.col(P.position, d)[i];
+    }
+    const double w = materials[P.material[i]]->strain_energy(P, i, i + 1);
+    if (!std::isnan(w)) t.carried_stored += sign * w;
+  }
 }
 
 template <int D>

@@ -15,6 +15,7 @@
 #include "damping.hpp"
 #include "diagnostics.hpp"
 #include "energies.hpp"
+#include "energy_ledger.hpp"
 #include "field.hpp"
 #include "generator.hpp"
 #include "grid.hpp"
@@ -70,6 +71,8 @@ class Simulation {
   std::vector<std::unique_ptr<Boundary<D>>> boundaries;
   /// The reaction of every mechanical condition of the run (its stages' included), per step.
   Reactions<D> reactions;
+  /// The energy balance's work and flows (framework/energy_ledger.hpp).
+  EnergyLedger<D> ledger;
   std::vector<std::unique_ptr<Load<D>>> loads;
   std::vector<std::unique_ptr<Source<D>>> sources;
   std::vector<std::unique_ptr<Sink<D>>> sinks;
@@ -170,6 +173,7 @@ class Simulation {
     for (int pass = 0; pass < 2; ++pass)
       for (const auto& b : boundaries)
         if (b->hydraulic() == (pass == 0)) b->before_constraints(u);
+    ledger.begin_update(u);
     if (!reactions.empty()) reactions.begin_update(boundaries, u, grid, *ranks);
     for (const auto& b : boundaries)
       if (!b->hydraulic()) b->constrain_grid_update(u);
@@ -179,6 +183,7 @@ class Simulation {
       if (b->hydraulic()) b->constrain_grid_update(u);
     coupling();
     if (!reactions.empty()) reactions.end_update(u);
+    ledger.end_update(u);
     timed("check_grid", [&] { check_grid(u); });
   }
   /// NaN or inf on the grid is caught in the step it appears (before the transfer to the
@@ -218,21 +223,38 @@ class Simulation {
     batch.dt = dt;
     batch.L = L;
     batch.particles = &set.particles;
+    if (!ledger.enabled) return materials[set.particles.material[b]]->update_stress(batch);
+    const double before = block_stress_power(set.particles, b, count, L);
     materials[set.particles.material[b]]->update_stress(batch);
+    ledger.add_stress_work(set_slot(set), b, before, block_stress_power(set.particles, b, count, L),
+                           dt);
   }
+  /// The index of `set` in sets.
+  size_t set_slot(const ParticleSet<D>& set) const { return size_t(&set - sets.data()); }
   /// Face forces of the boundary conditions (GridForces), before the grid update.
   void apply_boundary_forces(GridForces f) {
     f.time = time - loads_start;
-    for (const auto& b : boundaries)
-      reactions.measure_forces(*b, f, grid, *ranks, [&] { b->add_forces(f); });
+    for (const auto& b : boundaries) {
+      auto add = [&] { reactions.measure_forces(*b, f, grid, *ranks, [&] { b->add_forces(f); }); };
+      if (b->adds_forces())
+        ledger.record(NodalWork::kBoundaries, f.mixture, add);
+      else
+        add();  // none, or joined nodes (periodic), or a refresh (rigid_body)
+    }
   }
   void apply_grid_loads(const NodalVector& force) {
-    for (const auto& l : loads) l->apply_to_grid(*this, force, time - loads_start);
+    for (const auto& l : loads) {
+      auto add = [&] { l->apply_to_grid(*this, force, time - loads_start); };
+      if (l->uses_grid_forces())
+        ledger.record(NodalWork::kLoads, force, add);
+      else
+        add();
+    }
   }
   void apply_damping(const NodeForces& nf) {
     if (!damping) return;
     if (!reactions.empty()) reactions.before_damping(nf.force, grid, *ranks);
-    damping->apply(*this, nf);
+    ledger.record(NodalWork::kDamping, nf.force, [&] { damping->apply(*this, nf); });
     if (!reactions.empty()) reactions.after_damping(nf.force);
   }
   /// f(set, begin, count, thread) over the blocks of every set: race-free scatters set after
@@ -346,6 +368,13 @@ class Simulation {
   double motion_speed = 0;
   /// Zero and refill particle external forces from loads (only if a load uses them).
   void prepare_particle_loads();
+  /// sum f . x over the particles' external forces and positions (this rank's): its change over
+  /// a step is the particle loads' work on the particles' moves.
+  double particle_load_moment() const;
+  /// The energy particles [begin, end) of P (those with only[i] != 0, if given) bring into the
+  /// run (sign 1: created, activated) or take out of it (-1: removed), into ledger.totals.
+  void carry_energy(const Particles<D>& P, size_t begin, size_t end, double sign,
+                    const uint8_t* only = nullptr);
   /// Re-sort the particles of every set now.
   void sort();
   void sort(ParticleSet<D>& set);

@@ -82,6 +82,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   sort_every = int(num.integer("sort_every"));
   check_every = long(num.integer("check_every"));
   keep_last_good = num.flag("keep_last_good");
+  ledger.enabled = config.section("output").flag("energy_balance");
   mass_tolerance = num.real("mass_tolerance");
   for (const auto& s : config.list("selections")) {
     Vec lo{}, hi{};

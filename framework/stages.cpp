@@ -192,6 +192,7 @@ void Simulation<D>::begin_stage(int k) {
     size_t n = 0;
     for (size_t i = 0; i < P.size(); ++i)
       if (mine[i]) mass_removed += P.col(P.mass)[i], ++n;
+    carry_energy(P, 0, P.size(), -1.0, mine.data());
     P.erase(mine);
     removed += n;
     active_[size_t(b)] = 0;
@@ -204,6 +205,7 @@ void Simulation<D>::begin_stage(int k) {
     P.append(inactive_[size_t(b)]);
     inactive_[size_t(b)] = Particles<D>();
     for (size_t i = begin; i < P.size(); ++i) mass_created += P.col(P.mass)[i];
+    carry_energy(P, begin, P.size(), 1.0);
     created += P.size() - begin;
     restart_displacement(P, begin, P.size());  // its displacement counts from when it joins
     active_[size_t(b)] = 1;
@@ -217,6 +219,10 @@ void Simulation<D>::begin_stage(int k) {
     const auto& r = set.partition.material_ranges[size_t(c.body)];
     if (r.end > r.begin) materials[size_t(c.body)]->initialize(set.particles, r.begin, r.end);
   }
+  // A velocity reset takes the motion's kinetic energy out of the run (the energy balance's
+  // E_carried; energies() is over the ranks, counted once).
+  const bool take = st.reset_velocity && ledger.enabled;
+  const double kinetic_before = take ? energies().kinetic : 0.0;
   std::vector<std::string> velocities{"velocity"};
   for (const auto& f : scheme->velocity_fields()) velocities.push_back(f);
   for (auto& set : sets) {
@@ -232,7 +238,11 @@ void Simulation<D>::begin_stage(int k) {
     if (st.reset_plastic_strain) zero(plastic_strain_eq_field().name);
     if (st.reset_displacement) restart_displacement(P, 0, P.size());
   }
-  if (st.reset_velocity) max_speed = 0;
+  if (st.reset_velocity) {
+    max_speed = 0;
+    const double taken = take ? kinetic_before - energies().kinetic : 0.0;
+    if (ranks->root()) ledger.totals.carried_kinetic -= taken;
+  }
   if (!st.params.path().empty() && ranks->root())
     spdlog::info("stage {} '{}' begins at t = {:.6g} s", k + 1, st.name, time);
 }

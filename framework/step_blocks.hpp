@@ -94,6 +94,14 @@ LOAM_FORCE_INLINE double flip_pic(double flip, double v, double dt, double a_gri
   return flip * (v + dt * a_grid) + (1.0 - flip) * v_grid;
 }
 
+/// |v + dt a_grid|^2 - |v_new|^2 of one component: twice the kinetic energy per unit mass that a
+/// blended update v_new took against FLIP's (the energy balance's D_transfer,
+/// framework/energy_ledger.hpp).
+LOAM_FORCE_INLINE double transfer_loss(double v, double dt, double a_grid, double v_new) {
+  const double v_flip = v + dt * a_grid;
+  return v_flip * v_flip - v_new * v_new;
+}
+
 /// Stencil entry kp of particle p (kp = k * kBlock + p) adds v_I (x) grad N_I to l.
 template <int D>
 LOAM_FORCE_INLINE void add_velocity_gradient(double (&l)[D][D], const double* v_node,

@@ -178,6 +178,7 @@ nlohmann::json Run<D>::strength_reduction() {
   sim.save_last_good();
   const typename Simulation<D>::GoodState start = sim.last_good;  // the static state
   const std::vector<double> reactions = sim.reactions.state();    // the trials' are not the run's
+  const std::vector<double> ledger = sim.ledger.state();
   srf_strong_.clear();
   for (int b : srf_bodies_) srf_strong_.push_back(std::move(sim.materials[size_t(b)]));
   nlohmann::json trials = nlohmann::json::array();
@@ -213,6 +214,7 @@ nlohmann::json Run<D>::strength_reduction() {
   sim.last_good = start;
   sim.swap_last_good();
   sim.reactions.restore(reactions);
+  sim.ledger.restore(ledger);
   for (size_t i = 0; i < srf_bodies_.size(); ++i)
     sim.materials[size_t(srf_bodies_[i])] = std::move(srf_strong_[i]);
   for (auto& set : sim.sets) sim.restart_displacement(set.particles, 0, set.particles.size());

@@ -371,7 +371,7 @@ class SinglePhase : public Scheme<D> {
     // Locals, not members: the stores through v and x could alias them and force reloads.
     const double flip = flip_;
     const HeldFaces<D> walls = sim.held_faces;
-    double max_v2 = sc.max_v2;
+    double max_v2 = sc.max_v2, loss = 0;
     for (int p = 0; p < count; ++p) {
       double a[D] = {}, vn[D] = {};
       for (int k = 0; k < npp; ++k) {
@@ -386,6 +386,7 @@ class SinglePhase : public Scheme<D> {
       double v2 = 0, vp[D];
       for (int d = 0; d < D; ++d) {
         vp[d] = flip_pic(flip, v[size_t(d)][p], dt, a[d], vn[d]);
+        if (flip < 1) loss += m[p] * transfer_loss(v[size_t(d)][p], dt, a[d], vp[d]);
         v[size_t(d)][p] = vp[d];
         v2 += vp[d] * vp[d];
         if constexpr (MOVE) x[size_t(d)][p] = walls.moved(d, x[size_t(d)][p], dt * vn[d]);
@@ -402,6 +403,7 @@ class SinglePhase : public Scheme<D> {
       }
     }
     sc.max_v2 = max_v2;
+    if (flip < 1) sim.ledger.add_transfer_loss(sim.set_slot(set), b, 0.5 * loss);
   }
 
   /// APIC grid-to-particle update of one evaluated block (the header's equations) from the
@@ -492,7 +494,7 @@ class SinglePhase : public Scheme<D> {
     const double flip = flip_;
     const bool apic = affine_on_;  // USL with APIC: the velocities are updated already
     const HeldFaces<D> walls = sim.held_faces;
-    double max_v2 = sc.max_v2;
+    double max_v2 = sc.max_v2, loss = 0;
     // Linear tents with an affine transfer: the gradient is the particle's C_p.
     const bool store_C = MODE == Gradient::kCurrent && B_ >= 0 && affine_.needs_usf();
     typename AffineTransfer<D>::Columns C;
@@ -519,13 +521,16 @@ class SinglePhase : public Scheme<D> {
         double v2 = 0;
         for (int d = 0; d < D; ++d) {
           double& vp = v[size_t(d)][p];
+          const double v_old = vp;
           vp = flip_pic(flip, vp, dt, a[d], vn[d]);
+          if (flip < 1) loss += P.col(P.mass)[b + size_t(p)] * transfer_loss(v_old, dt, a[d], vp);
           v2 += vp * vp;
         }
         max_v2 = std::max(max_v2, v2);
       }
     }
     sc.max_v2 = max_v2;
+    if (flip < 1) sim.ledger.add_transfer_loss(sim.set_slot(set), b, 0.5 * loss);
     sim.update_block_stress(set, b, count, dt, L);
   }
 };

@@ -571,8 +571,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     sim.timed("g2p_velocity_remap", [&] {
       sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
         with_form<NPP>(sim, s, b, c, t, [&](auto form) {
-          remap<NPP, decltype(form)::value>(s, &s == &sim.sets[kSolid] ? kSolid : kLiquid, dt, b, c,
-                                            t);
+          remap<NPP, decltype(form)::value>(sim, s, &s == &sim.sets[kSolid] ? kSolid : kLiquid, dt,
+                                            b, c, t);
         });
       });
     });
@@ -836,6 +836,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         if (has_s && has_w) {
           const auto s = solve_drag_implicit(ms, mw, Q, dt, ms * v / dt + Fs, mw * w / dt + Fw);
           vn = s.solid, wn = s.water;
+          if (sim.ledger.enabled) sim.ledger.add_drag(i, dt * Q * (wn - vn) * (wn - vn));
         } else if (has_s) {
           vn = v + dt * Fs / ms;
         } else if (has_w) {
@@ -861,7 +862,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   /// phase's nodal velocity and acceleration, the move dt v_grid kept for the gradient pass,
   /// and the scatter of the new momentum (the points stay at x^n).
   template <int NPP, AffineForm FORM>
-  void remap(ParticleSet<D>& set, int phase, double dt, size_t b, int count, int thread) {
+  void remap(Simulation<D>& sim, ParticleSet<D>& set, int phase, double dt, size_t b, int count,
+             int thread) {
     constexpr bool AFFINE = FORM != AffineForm::kOff;
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
@@ -872,7 +874,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     const double* m = P.col(P.mass) + b;
     double* move = move_[phase].data() + b * D;
     const double flip = flip_;
-    double max_v2 = sc.max_v2;
+    double max_v2 = sc.max_v2, loss = 0;
     AffineStencil as;
     Momenta<NPP, FORM> am;  // APIC: the momenta per unit weight
     typename AffineTransfer<D>::Columns B;
@@ -900,7 +902,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       double v2 = 0, vp[D];
       for (int d = 0; d < D; ++d) {
         double& v = P.col(P.velocity, d)[i];
+        const double v_old = v;
         v = vp[d] = AFFINE ? vg[d] : flip_pic(flip, v, dt, ag[d], vg[d]);
+        if (!AFFINE && flip < 1) loss += m[p] * transfer_loss(v_old, dt, ag[d], vp[d]);
         move[size_t(p) * D + size_t(d)] = dt * vg[d];
         v2 += vp[d] * vp[d];
       }
@@ -928,6 +932,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       }
     }
     sc.max_v2 = max_v2;
+    if (flip < 1) sim.ledger.add_transfer_loss(sim.set_slot(set), b, 0.5 * loss);
   }
 
   /// Re-mapped momenta to velocities (the node masses of the step), constrained like the update.

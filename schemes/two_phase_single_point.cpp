@@ -542,6 +542,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         r[kW + d] = solved[D + d] = wn;
         r[kF + d] = (vn - v) / dt;
         r[kFw + d] = (wn - w) / dt;
+        if (sim.ledger.enabled) sim.ledger.add_drag(i, dt * Q * (wn - vn) * (wn - vn));
       }
     });
   }
@@ -559,7 +560,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     Scratch& sc = *scratch_[size_t(thread)];
     const StencilBlock<D>& st = sc.stencil;
     const int npp = NPP ? NPP : st.npp;
-    double max_v2 = sc.max_v2;
+    double max_v2 = sc.max_v2, loss = 0;
     AffineStencil as;
     Momenta<NPP, FORM> am_s, am_w;  // APIC: the phases' momenta per unit weight
     AffineColumns B;
@@ -570,8 +571,9 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     for (int p = 0; p < count; ++p) {
       const size_t i = b + size_t(p);
       double vs[D], vw[D];
-      max_v2 = std::max(max_v2, velocity_update<NPP, false, FORM>(sim, P, st, p, i, npp, dt,
-                                                                  &move_[i * D], vs, vw, &as, B));
+      max_v2 =
+          std::max(max_v2, velocity_update<NPP, false, FORM>(sim, P, st, p, i, npp, dt,
+                                                             &move_[i * D], vs, vw, &as, B, loss));
       const double ms = m[i], mw = n[i] * rho_w_ * V[i];
       // The re-map carries the affine momenta, with D_p at x^n (as the scatter).
       if constexpr (AFFINE) affine_momenta<NPP>(B, vs, vw, i, npp, ms, mw, as, am_s, am_w);
@@ -591,6 +593,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
           });
     }
     sc.max_v2 = max_v2;
+    if (flip_ < 1) sim.ledger.add_transfer_loss(sim.set_slot(set), b, 0.5 * loss);
   }
 
   /// Remapped momenta to velocities (node masses of the step), constrained like the update.
@@ -619,7 +622,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   template <int NPP, bool MOVE, AffineForm FORM>
   double velocity_update(const Simulation<D>& sim, Particles<D>& P, const StencilBlock<D>& st,
                          int p, size_t i, int npp, double dt, double* move, double (&vs)[D],
-                         double (&vw)[D], AffineStencil* as, const AffineColumns& B) {
+                         double (&vw)[D], AffineStencil* as, const AffineColumns& B, double& loss) {
     constexpr bool AFFINE = FORM != AffineForm::kOff;
     double vn[D] = {}, wn[D] = {}, acc_s[D] = {}, acc_w[D] = {};
     typename AffineTransfer<D>::template MomentSum<NPP, FORM> sum_s, sum_w;  // both phases' B_p
@@ -661,8 +664,13 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         v = vn[d];
         w = wn[d];
       } else {
+        const double v_old = v, w_old = w;
         v = flip_pic(flip_, v, dt, acc_s[d], vn[d]);
         w = flip_pic(flip_, w, dt, acc_w[d], wn[d]);
+        if (flip_ < 1)
+          loss +=
+              P.col(P.mass)[i] * transfer_loss(v_old, dt, acc_s[d], v) +
+              P.col(n_)[i] * rho_w_ * P.col(P.volume)[i] * transfer_loss(w_old, dt, acc_w[d], w);
       }
       vs[d] = v;
       vw[d] = w;
@@ -689,7 +697,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     if constexpr (FORM != AffineForm::kOff) B = affine_columns(P);
     const double* g = node_.data();
     double* L = sc.L.data();
-    double max_v2 = sc.max_v2;
+    double max_v2 = sc.max_v2, loss = 0;
     const auto F = deformation_gradient_block(P, F_, b);
     AffineStencil as;
     for (int p = 0; p < count; ++p) {
@@ -699,7 +707,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       if constexpr (!REMAPPED) {
         double vs[D], vw[D];
         max_v2 = std::max(max_v2, velocity_update<NPP, true, FORM>(sim, P, st, p, i, npp, dt,
-                                                                   nullptr, vs, vw, &as, B));
+                                                                   nullptr, vs, vw, &as, B, loss));
       }
       double ls[D][D] = {}, lw[D][D] = {};
       for (int k = 0; k < npp; ++k) {
@@ -732,6 +740,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       if (!(n > 0 && n < 1)) sc.bad_porosity = long(i);
     }
     sc.max_v2 = max_v2;
+    if (flip_ < 1) sim.ledger.add_transfer_loss(sim.set_slot(set), b, 0.5 * loss);
     sim.update_block_stress(set, b, count, dt, L);
   }
 };

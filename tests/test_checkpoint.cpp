@@ -96,6 +96,17 @@ TEST_CASE("a resumed APIC run (affine_moment) is bitwise the uninterrupted one, 
                1000, 2000);
 }
 
+TEST_CASE("a resumed run continues its energy balance bitwise, 1 and 2 threads",
+          "[checkpoint][energy]") {
+  // configs/granular_collapse_2d.yaml (flip 0.98: every term of the ledger but loads and drag
+  // moves) to t = 0.3 s with output.energy_balance: the checkpoint carries the ledger's sums,
+  // so history.csv's balance columns and summary.json's energy_balance match the uninterrupted
+  // run's bit for bit.
+  check_resume("granular_collapse_2d.yaml",
+               "--set output.energy_balance=true --set time.end=0.3 --set output.every_time=0.05",
+               500, 1000);
+}
+
 TEST_CASE("a resumed two-phase run is bitwise the uninterrupted one, 1 and 2 threads",
           "[checkpoint]") {
   // configs/seed001_terzaghi.yaml (two_phase_single_point, terzaghi reference) to t = 0.05 s

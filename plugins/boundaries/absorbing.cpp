@@ -119,6 +119,7 @@ class Absorbing : public Boundary<D> {
   /// velocities, the free-field reaction is each stored copy's own (the same on every rank that
   /// stores the node) and goes into each rank's checkpoint.
   bool runs_on_ranks() const override { return true; }
+  bool adds_forces() const override { return free_field_; }
 
   /// free_field: the reaction of the first step, R = -f at the face's nodes (every component,
   /// each phase), then added to every step's forces.

@@ -61,6 +61,7 @@ class PrescribedPorePressure : public HydraulicFace<D> {
   /// Per node of the face, on the stored box (docs/parallel.md): the face forces are added
   /// after the nodal sums are complete, to every stored copy of a node alike.
   bool runs_on_ranks() const override { return true; }
+  bool adds_forces() const override { return true; }
   void add_forces(const GridForces& f) const override {
     if (f.count < 2 || !f.porosity.base) return;
     const int a = this->face_.axis;

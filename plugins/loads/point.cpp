@@ -50,6 +50,7 @@ class PointLoad : public Load<D> {
   }
   /// Added to every stored copy of its nodes, after the nodal sums are complete, as gravity.
   bool runs_on_ranks() const override { return true; }
+  bool uses_grid_forces() const override { return true; }
   void apply_to_grid(Simulation<D>&, const NodalVector& force, double t) override {
     const double s = time_(t);
     for (size_t k = 0; k < nodes_.size(); ++k)

@@ -69,6 +69,7 @@ class Traction : public Load<D> {
     for (int d = 0; d < D; ++d) t_[size_t(d)] = p.vec("traction")[size_t(d)];
   }
   bool uses_particle_forces() const override { return !surface_; }
+  bool uses_grid_forces() const override { return surface_; }
   /// Applied as particle forces (scattered before the nodal sums are completed), each rank
   /// holding every loaded particle's id and area, so a particle that changes rank keeps its
   /// load. At the surface: each rank adds its own particles' surface forces to a nodal array
