@@ -1,8 +1,8 @@
 #pragma once
 // The energy balance of a run (history.csv): where the work done on the model went.
 //
-//   E_kin + E_stored + E_grav + D_material + D_damping + D_transfer - W_loads - W_boundaries
-//     - E_carried - E_0 = balance
+//   E_kin + E_stored + E_grav + D_material + D_damping + D_transfer + D_drag - W_loads
+//     - W_boundaries - E_carried - E_0 = balance
 //
 // Every term is summed since the run began (J; per unit thickness in 2D):
 // - D_material, the stress work not stored: sum over steps and particles of V sigma : L dt with
@@ -169,10 +169,17 @@ class EnergyLedger {
     if (enabled) blocks_[set][b].transfer += loss;
   }
 
-  /// Records the change `act` makes to `force` (phase 0, every node) as a force of `kind`.
+  /// Runs `act` and records the change it makes to `force` (phase 0, every node) as a force of
+  /// `kind`.
   template <class F>
   void record(NodalWork kind, const NodalVector& force, F&& act) {
-    if (!enabled) return act();
+    record_if(true, kind, force, act);
+  }
+  /// As record, where `adds` says whether `act` adds forces at all (one that joins nodes or
+  /// refreshes its own state is not work done on the model).
+  template <class F>
+  void record_if(bool adds, NodalWork kind, const NodalVector& force, F&& act) {
+    if (!enabled || !adds) return act();
     before_.resize(num_nodes_ * D);
     for (size_t n = 0; n < num_nodes_; ++n)
       for (int d = 0; d < D; ++d) before_[n * D + size_t(d)] = force.at(n, d);
@@ -242,7 +249,6 @@ class EnergyLedger {
   struct BlockSums {
     double stress = 0, transfer = 0;
   };
-  static double sq(double x) { return x * x; }
   /// Under mpirun each node is counted by the rank that owns it.
   void owned_nodes(const Grid<D>& grid, const Ranks<D>& ranks) {
     distributed_ = ranks.distributed();

@@ -234,22 +234,15 @@ class Simulation {
   /// Face forces of the boundary conditions (GridForces), before the grid update.
   void apply_boundary_forces(GridForces f) {
     f.time = time - loads_start;
-    for (const auto& b : boundaries) {
-      auto add = [&] { reactions.measure_forces(*b, f, grid, *ranks, [&] { b->add_forces(f); }); };
-      if (b->adds_forces())
-        ledger.record(NodalWork::kBoundaries, f.mixture, add);
-      else
-        add();  // none, or joined nodes (periodic), or a refresh (rigid_body)
-    }
+    for (const auto& b : boundaries)  // some add none, join nodes (periodic) or refresh
+      ledger.record_if(b->adds_forces(), NodalWork::kBoundaries, f.mixture, [&] {
+        reactions.measure_forces(*b, f, grid, *ranks, [&] { b->add_forces(f); });
+      });
   }
   void apply_grid_loads(const NodalVector& force) {
-    for (const auto& l : loads) {
-      auto add = [&] { l->apply_to_grid(*this, force, time - loads_start); };
-      if (l->uses_grid_forces())
-        ledger.record(NodalWork::kLoads, force, add);
-      else
-        add();
-    }
+    for (const auto& l : loads)
+      ledger.record_if(l->uses_grid_forces(), NodalWork::kLoads, force,
+                       [&] { l->apply_to_grid(*this, force, time - loads_start); });
   }
   void apply_damping(const NodeForces& nf) {
     if (!damping) return;
