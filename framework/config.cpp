@@ -218,6 +218,10 @@ Schema config_schema() {
   s.plugin_list("sources", "source", "particle sources: inflow of a body's particles");
   s.plugin_list("sinks", "sink", "particle sinks: outflow, removing particles");
   s.plugin("damping", "damping", "numerical damping (e.g. to reach a static state)");
+  s.plugin("contact", "contact",
+           "contact between bodies: each body in contact moves on its own velocity field and "
+           "the law exchanges momentum where they meet (absent: one velocity field, bodies "
+           "stick where they touch)");
   {
     Schema t;
     t.real("end", "s", "simulated end time (a run with `stages:` gives each stage's time instead)")

@@ -1,8 +1,8 @@
 #pragma once
 // The energy balance of a run (history.csv): where the work done on the model went.
 //
-//   E_kin + E_stored + E_grav + D_material + D_damping + D_transfer + D_drag - W_loads
-//     - W_boundaries - E_carried - E_0 = balance
+//   E_kin + E_stored + E_grav + D_material + D_damping + D_transfer + D_drag + D_contact
+//     - W_loads - W_boundaries - E_carried - E_0 = balance
 //
 // Every term is summed since the run began (J; per unit thickness in 2D):
 // - D_material, the stress work not stored: sum over steps and particles of V sigma : L dt with
@@ -17,6 +17,8 @@
 //   stage and the face forces they add (absorbing);
 // - D_drag, the two-phase drag's dissipation, Q |w - v|^2 dt per node at the implicit solve's
 //   velocities (the pore water's pressure work ends there and in the stored p^2 n V / (2 K_w));
+// - D_contact, minus the work of the contact forces between bodies on their own velocity fields
+//   (framework/contact_fields.hpp): the normal impulses that stop an approach and friction;
 // - E_carried: the energy of the particles created (sources, bodies a stage activates) less that
 //   of the particles removed (sinks, deactivated bodies);
 // - E_0 the energy at the start.
@@ -60,7 +62,7 @@ double block_stress_power(const Particles<D>& P, size_t b, int count, const doub
 
 /// The balance's terms (J), as history.csv writes them.
 struct EnergyBalance {
-  double material = 0, damping = 0, transfer = 0, drag = 0;  // dissipations
+  double material = 0, damping = 0, transfer = 0, drag = 0, contact = 0;  // dissipations
   double loads = 0, boundaries = 0, carried = 0;  // work done on the model, energy brought in
   double balance = 0;
   /// The largest magnitude of the energies and terms, the balance's scale.
@@ -77,15 +79,16 @@ EnergyBalance energy_balance(const Energies& now, const Energies& start, const T
   b.damping = -t.damping;
   b.transfer = t.transfer;
   b.drag = t.drag;
+  b.contact = t.contact;
   b.loads = t.loads;
   b.boundaries = t.boundaries;
   b.carried = t.carried_kinetic + t.carried_stored + t.carried_gravity;
   const double e_now = now.kinetic + stored(now.strain) + now.gravity;
   const double e_start = start.kinetic + stored(start.strain) + start.gravity;
-  b.balance = e_now + b.material + b.damping + b.transfer + b.drag - b.loads - b.boundaries -
-              b.carried - e_start;
+  b.balance = e_now + b.material + b.damping + b.transfer + b.drag + b.contact - b.loads -
+              b.boundaries - b.carried - e_start;
   for (double x : {now.kinetic, stored(now.strain), now.gravity - start.gravity, b.material,
-                   b.damping, b.transfer, b.drag, b.loads, b.boundaries, b.carried})
+                   b.damping, b.transfer, b.drag, b.contact, b.loads, b.boundaries, b.carried})
     b.largest = std::max(b.largest, std::abs(x));
   return b;
 }
@@ -101,6 +104,7 @@ class EnergyLedger {
     double stress_work = 0;  // sum V sigma : L dt (the materials' stress work)
     double transfer = 0;     // sum 1/2 m (|v_FLIP|^2 - |v^{n+1}|^2) at the particle updates
     double drag = 0;         // sum Q |w - v|^2 dt over the nodes (two-phase schemes)
+    double contact = 0;      // minus the contact forces' work (contact between bodies)
     double damping = 0;      // the damping forces' work (<= 0)
     double loads = 0;        // tractions, point loads, cavity pressure
     double boundaries = 0;   // the conditions' constraint stage and face forces
@@ -138,17 +142,18 @@ class EnergyLedger {
   template <class R>
   void end_step(const R& ranks, double particle_loads) {
     if (!enabled) return;
-    double step[6] = {0, 0, node_work_[0] + particle_loads, node_work_[1], node_work_[2], 0};
+    double step[7] = {0, 0, node_work_[0] + particle_loads, node_work_[1], node_work_[2], 0, 0};
     for (const auto& set : blocks_)  // in block order: the same sum at any thread schedule
       for (const BlockSums& b : set) step[0] += b.stress, step[1] += b.transfer;
-    for (auto& s : per_thread_) step[5] += s.drag, s = Padded{};
-    if (ranks.distributed()) ranks.sum(step, 6);
+    for (auto& s : per_thread_) step[5] += s.drag, step[6] += s.contact, s = Padded{};
+    if (ranks.distributed()) ranks.sum(step, 7);
     totals.stress_work += step[0];
     totals.transfer += step[1];
     totals.loads += step[2];
     totals.damping += step[3];
     totals.boundaries += step[4];
     totals.drag += step[5];
+    totals.contact += step[6];
     node_work_.fill(0.0);
   }
 
@@ -162,6 +167,11 @@ class EnergyLedger {
   void add_drag(size_t n, double dissipated) {
     if (enabled && (!distributed_ || owned_[n]))
       per_thread_[size_t(omp_get_thread_num())].drag += dissipated;
+  }
+  /// The contact forces' dissipation at node n in this step (as add_drag).
+  void add_contact(size_t n, double dissipated) {
+    if (enabled && (!distributed_ || owned_[n]))
+      per_thread_[size_t(omp_get_thread_num())].contact += dissipated;
   }
   /// Kinetic energy the grid-to-particle update of the block of set `set` that begins at
   /// particle b took against FLIP.
@@ -232,19 +242,20 @@ class EnergyLedger {
   std::vector<double> state() const {
     const Totals& t = totals;
     return {t.stress_work,     t.transfer,       t.damping,         t.loads, t.boundaries,
-            t.carried_kinetic, t.carried_stored, t.carried_gravity, t.drag};
+            t.carried_kinetic, t.carried_stored, t.carried_gravity, t.drag,  t.contact};
   }
   void restore(const std::vector<double>& s) {
-    if (s.size() != 9) return;
+    if (s.size() != 9 && s.size() != 10) return;  // 9: written before contact
     Totals& t = totals;
     t.stress_work = s[0], t.transfer = s[1], t.damping = s[2], t.loads = s[3];
     t.boundaries = s[4], t.carried_kinetic = s[5], t.carried_stored = s[6];
     t.carried_gravity = s[7], t.drag = s[8];
+    t.contact = s.size() > 9 ? s[9] : 0.0;
   }
 
  private:
   struct alignas(64) Padded {
-    double drag = 0;
+    double drag = 0, contact = 0;
   };
   struct BlockSums {
     double stress = 0, transfer = 0;
@@ -285,7 +296,7 @@ class EnergyLedger {
   }
 
   size_t num_nodes_ = 0;
-  std::vector<Padded> per_thread_;  // per thread, the step's drag dissipation
+  std::vector<Padded> per_thread_;  // per thread, the step's drag and contact dissipation
   // Per set and particle index, the step's sums of the block that begins there: blocks begin
   // where the partition's ranges do, not on multiples of kBlock.
   std::vector<std::vector<BlockSums>> blocks_;

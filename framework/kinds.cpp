@@ -11,6 +11,8 @@ LOAM_REGISTER_KIND("load", "external forces on particles or nodes")
 LOAM_REGISTER_KIND("time_function",
                    "a factor f(t) of the time since its stage began (a load's ramp or pulse)")
 LOAM_REGISTER_KIND("damping", "numerical damping of nodal forces")
+LOAM_REGISTER_KIND("contact",
+                   "how bodies on their own velocity fields exchange momentum where they meet")
 LOAM_REGISTER_KIND("source", "particles created while the run goes (inflow)")
 LOAM_REGISTER_KIND("sink", "particles removed while the run goes (outflow)")
 LOAM_REGISTER_KIND("generator", "regions filled with particles")

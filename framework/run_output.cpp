@@ -261,6 +261,7 @@ void Run<D>::open_outputs(long resume_step) {
     history_.out() << ",dissipation_material,dissipation_damping,dissipation_transfer,dissipation_"
                       "drag,work_loads,"
                       "work_boundaries,energy_carried,energy_balance";
+  if (sim_->ledger.enabled && sim_->contact) history_.out() << ",dissipation_contact";
   for (const auto& name : sim_->reactions.names())
     for (int k = 0; k < sim_->scheme->phases(); ++k)
       for (int d = 0; d < D; ++d)
@@ -382,6 +383,7 @@ void Run<D>::write_history() {
     for (double x :
          {b.material, b.damping, b.transfer, b.drag, b.loads, b.boundaries, b.carried, b.balance})
       o << "," << x;
+  if (sim_->ledger.enabled && sim_->contact) o << "," << b.contact;
   const Reactions<D>& r = sim_->reactions;
   for (size_t c = 0; c < r.names().size(); ++c)
     for (int k = 0; k < sim_->scheme->phases(); ++k)

@@ -94,6 +94,7 @@ nlohmann::json balance_json(const EnergyBalance& b) {
                         {"dissipation_damping", b.damping},
                         {"dissipation_transfer", b.transfer},
                         {"dissipation_drag", b.drag},
+                        {"dissipation_contact", b.contact},
                         {"work_loads", b.loads},
                         {"work_boundaries", b.boundaries},
                         {"energy_carried", b.carried},

@@ -63,6 +63,9 @@ class Scheme {
   /// the particles of this rank and the stored box of nodes, each node as the whole grid's
   /// value. Default false: a run under mpirun refuses it with a located error.
   virtual bool runs_on_ranks() const { return false; }
+  /// Whether it gives each body in contact its own velocity field (`contact:`,
+  /// framework/contact_fields.hpp). Default false: `contact:` is refused with a located error.
+  virtual bool supports_contact() const { return false; }
 };
 
 /// The `flip` parameter shared by the schemes: FLIP fraction of the particle velocity update.

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "boundary.hpp"
+#include "contact.hpp"
 #include "damping.hpp"
 #include "diagnostics.hpp"
 #include "energies.hpp"
@@ -77,6 +78,8 @@ class Simulation {
   std::vector<std::unique_ptr<Source<D>>> sources;
   std::vector<std::unique_ptr<Sink<D>>> sinks;
   std::unique_ptr<Damping<D>> damping;
+  /// The contact law between bodies on their own velocity fields (`contact:`), or null.
+  std::unique_ptr<Contact<D>> contact;
   std::unique_ptr<Reference<D>> reference;
   /// The stages of the run (`stages:`; one implicit stage of time.end without it), and the one
   /// running (-1 before the first has begun). docs/stages.md.
@@ -186,6 +189,8 @@ class Simulation {
     ledger.end_update(u);
     timed("check_grid", [&] { check_grid(u); });
   }
+  /// The components of `phase` the conditions held in the last constrain_update.
+  const HeldComponents& held(int phase) const { return held_[size_t(phase)]; }
   /// NaN or inf on the grid is caught in the step it appears (before the transfer to the
   /// particles spreads it): one pass over each phase's nodal velocity and acceleration after the
   /// conditions, sum of 0 * value (NaN for any non-finite value, 0 otherwise), then the first

@@ -103,6 +103,11 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
     for (auto& s : sets) s.particles.resize(0);  // check the remaining set-up on an empty model
   // Plugins see the generated particles in set-up (e.g. to select faces or request fields).
   shape->setup(*this, diag);
+  if (contact && !scheme->supports_contact())
+    diag.error(config.section("contact").where(), "contact",
+               "scheme '" + config.section("scheme").type() +
+                   "' has one velocity field per phase: contact between bodies needs a scheme "
+                   "that gives each body its own (docs/contact.md)");
   scheme->setup(*this, diag);
   for (size_t m = 0; m < materials.size(); ++m) materials[m]->setup(*this, int(m), diag);
   setup_stage_plugins("materials", diag);
@@ -220,6 +225,7 @@ void Simulation<D>::create_plugins(Diagnostics& diag) {
   for (const auto& p : config.list("sources")) sources.push_back(reg.create<Source, D>(p));
   for (const auto& p : config.list("sinks")) sinks.push_back(reg.create<Sink, D>(p));
   if (config.has("damping")) damping = reg.create<Damping, D>(config.section("damping"));
+  if (config.has("contact")) contact = reg.create<Contact, D>(config.section("contact"));
   if (config.has("verify")) reference = reg.create<Reference, D>(config.section("verify"));
   const auto& bl = config.list("bodies");
   for (size_t i = 0; i < bl.size(); ++i) {
@@ -263,6 +269,7 @@ void Simulation<D>::split_over_ranks(Diagnostics& diag) {
   }
   if (reference && config.given("verify"))
     refuse_plugin(reference->runs_on_ranks(), config.section("verify"));
+  if (contact) refuse_plugin(false, config.section("contact"));
   if (!shape || !diag.ok()) return;
   // A periodic axis stays whole on every rank (its faces are joined node by node).
   std::array<bool, D> whole{};

@@ -7,6 +7,10 @@
 // TPIC, Nakamura et al. 2023) with every update variant (framework/affine_transfer.hpp has the
 // equations and why linear tents take them with update: usf only); the field affine_moment holds
 // APIC's B_p, or C_p (TPIC, linear tents).
+//
+// With `contact:` each body in contact scatters onto a velocity field of its own and takes its
+// velocity from it (framework/contact_fields.hpp); the loads, conditions and damping act on the
+// fields' sum, the record every output sees.
 #include <omp.h>
 
 #include <algorithm>
@@ -14,6 +18,7 @@
 #include <memory>
 
 #include "framework/affine_transfer.hpp"
+#include "framework/contact_fields.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 #include "framework/step_blocks.hpp"
@@ -77,6 +82,13 @@ class SinglePhase : public Scheme<D> {
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     node_.assign(sim.grid.num_nodes * S, 0.0);
+    if (sim.contact) {
+      contact_.setup(sim, sim.config.section("contact"), diag);
+      if (affine_on_)
+        diag.error(params_.where("transfer"), params_.path("transfer"),
+                   "contact between bodies takes transfer: flip (the affine moments of two "
+                   "velocity fields are not implemented)");
+    }
     vel_.assign(sim.grid.num_nodes * D, 0.0);
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch&) {});
@@ -99,6 +111,7 @@ class SinglePhase : public Scheme<D> {
 
   /// Every nodal sum completed over the ranks after its scatter (Simulation::complete_nodes).
   bool runs_on_ranks() const override { return true; }
+  bool supports_contact() const override { return true; }
 
   std::vector<GridFieldView> grid_fields() const override {
     return {{"mass", 1, node_.data(), S, kMass},
@@ -111,10 +124,17 @@ class SinglePhase : public Scheme<D> {
     F_ = sim.deformation_gradient;
     with_stencil_size<D>(sim.shape->nodes_per_particle(), [&](auto npp) {
       constexpr int NPP = decltype(npp)::value;
-      if (update_ == "usf")
-        step_usf<NPP>(sim, dt);
+      auto with_fields = [&](auto fields) {
+        constexpr Fields FIELDS = decltype(fields)::value;
+        if (update_ == "usf")
+          step_usf<NPP, FIELDS>(sim, dt);
+        else
+          step_usl_musl<NPP, FIELDS>(sim, dt, update_ == "musl");
+      };
+      if (contact_.on())
+        with_fields(std::integral_constant<Fields, Fields::kPerBody>{});
       else
-        step_usl_musl<NPP>(sim, dt, update_ == "musl");
+        with_fields(std::integral_constant<Fields, Fields::kShared>{});
     });
   }
 
@@ -134,6 +154,9 @@ class SinglePhase : public Scheme<D> {
   int F_ = -1;                // deformation gradient handle, or -1
   std::vector<double> node_;  // num_nodes * S
   std::vector<double> vel_;   // num_nodes * D: velocity used for the velocity gradient
+  ContactFields<D> contact_;  // the bodies' own velocity fields, with `contact:`
+  static_assert(ContactFields<D>::S == S && ContactFields<D>::kForce == kForce);
+  static constexpr int G = ContactFields<D>::G;
   using Scratch = BlockScratch<D>;
   std::vector<std::unique_ptr<Scratch>> scratch_;
 
@@ -141,68 +164,136 @@ class SinglePhase : public Scheme<D> {
   NodalVector vel_vector() { return NodalVector{vel_.data(), D, 0}; }
 
   // ------------------------------------------------------------------ the steps
-  template <int NPP>
+  template <int NPP, Fields FIELDS>
   void step_usl_musl(Simulation<D>& sim, double dt, bool musl) {
-    sim.timed("grid", [&] { zero_nodes(node_, sim.threads); });
-    sim.timed("p2g", [&] { scatter_all<NPP, true, true>(sim); });
-    sim.complete_nodes({{node_.data(), S, S}});
-    sim.timed("grid", [&] { update_nodes(sim, dt); });
+    sim.timed("grid", [&] { zero_records<FIELDS>(sim); });
+    sim.timed("p2g", [&] { scatter_all<NPP, true, true, FIELDS>(sim); });
+    complete_records<FIELDS>(sim, kMass, S, true);
+    sim.timed("grid", [&] { update_nodes<FIELDS>(sim, dt); });
     reset_max_speed(scratch_);
     if (musl) {
       // MUSL: re-map the updated particle momentum; the velocity gradient uses that field, and
       // particles move with the grid velocity of the update (Sulsky 1995).
-      sim.timed("grid", [&] { zero_nodes(vel_, sim.threads); });
-      sim.timed("g2p_velocity_remap", [&] { update_velocities<NPP, true, false>(sim, dt); });
-      sim.complete_nodes({{vel_.data(), D, D}});
-      sim.timed("grid", [&] { momentum_to_velocity(sim, vel_.data(), D, 0); });
-      sim.timed("g2p_gradient_stress", [&] { update_stresses<NPP, Gradient::kRemapped>(sim, dt); });
+      sim.timed("grid", [&] { zero_remap<FIELDS>(sim); });
+      sim.timed("g2p_velocity_remap",
+                [&] { update_velocities<NPP, true, false, FIELDS>(sim, dt); });
+      sim.timed("grid", [&] { remapped_velocities<FIELDS>(sim); });
+      sim.timed("g2p_gradient_stress",
+                [&] { update_stresses<NPP, Gradient::kRemapped, FIELDS>(sim, dt); });
     } else {
       // USL: gradient, move and velocity update from the updated grid record in one pass (APIC:
       // its G2P first, at the positions before the move; the pass then only moves).
       if (affine_on_)
-        sim.timed("g2p_velocity", [&] { update_velocities<NPP, false, false>(sim, dt); });
-      sim.timed("g2p_gradient_stress", [&] { update_stresses<NPP, Gradient::kUpdated>(sim, dt); });
+        sim.timed("g2p_velocity", [&] { update_velocities<NPP, false, false, FIELDS>(sim, dt); });
+      sim.timed("g2p_gradient_stress",
+                [&] { update_stresses<NPP, Gradient::kUpdated, FIELDS>(sim, dt); });
     }
     sim.max_speed = max_speed(scratch_);
   }
 
-  template <int NPP>
+  template <int NPP, Fields FIELDS>
   void step_usf(Simulation<D>& sim, double dt) {
     // USF: stress from the velocity field at t^n, then forces, then the grid update.
-    zero_nodes(node_, sim.threads);
-    scatter_all<NPP, true, false>(sim);
-    sim.complete_nodes({{node_.data(), S, 1 + D, kMass}});
+    zero_records<FIELDS>(sim);
+    scatter_all<NPP, true, false, FIELDS>(sim);
+    complete_records<FIELDS>(sim, kMass, 1 + D, true);
     momentum_to_velocity(sim, node_.data(), S, kMomentum);
-    update_stresses<NPP, Gradient::kCurrent>(sim, dt);
-    scatter_all<NPP, false, true>(sim);
-    sim.complete_nodes({{node_.data(), S, D, kForce}});
-    update_nodes(sim, dt);
+    if constexpr (FIELDS == Fields::kPerBody)
+      contact_.velocities_from_momenta(sim, ContactFields<D>::Momentum::kRecord);
+    update_stresses<NPP, Gradient::kCurrent, FIELDS>(sim, dt);
+    scatter_all<NPP, false, true, FIELDS>(sim);
+    complete_records<FIELDS>(sim, kForce, D, false);
+    update_nodes<FIELDS>(sim, dt);
     reset_max_speed(scratch_);
-    update_velocities<NPP, false, true>(sim, dt);
+    update_velocities<NPP, false, true, FIELDS>(sim, dt);
     sim.max_speed = max_speed(scratch_);
+  }
+
+  // ------------------------------------------------------------------ the fields
+  /// A new scatter: the shared record, and the bodies' fields with contact.
+  template <Fields FIELDS>
+  void zero_records(Simulation<D>& sim) {
+    if constexpr (FIELDS == Fields::kPerBody) contact_.zero_records(sim.threads);
+    zero_nodes(node_, sim.threads);
+  }
+  /// The record slots [first, first + width) complete over the ranks; with contact the shared
+  /// record is the fields' sum (their volumes too, `volumes`).
+  template <Fields FIELDS>
+  void complete_records(Simulation<D>& sim, int first, int width, bool volumes) {
+    if constexpr (FIELDS == Fields::kShared) {
+      sim.complete_nodes({{node_.data(), S, width, first}});
+    } else {
+      contact_.complete(sim, first, width, volumes);
+      contact_.sum_into(node_.data(), first, width, sim.threads);
+    }
+  }
+  template <Fields FIELDS>
+  void zero_remap(Simulation<D>& sim) {
+    if constexpr (FIELDS == Fields::kPerBody) contact_.zero_velocities(sim.threads);
+    zero_nodes(vel_, sim.threads);
+  }
+  /// The re-mapped momenta to velocities (MUSL): the shared field's, and with contact each
+  /// body's with the contact exchange.
+  template <Fields FIELDS>
+  void remapped_velocities(Simulation<D>& sim) {
+    if constexpr (FIELDS == Fields::kPerBody) {
+      contact_.complete_velocities(sim);
+      contact_.velocities_from_momenta(sim, ContactFields<D>::Momentum::kRemap);
+    } else {
+      sim.complete_nodes({{vel_.data(), D, D}});
+      momentum_to_velocity(sim, vel_.data(), D, 0);
+    }
+  }
+  /// Where the particles of a set find their node records (stride S), velocities (stride D)
+  /// and, with contact, volumes (stride G): the shared ones, or their body's field. Taken into a
+  /// kernel's locals before its loop.
+  template <Fields FIELDS>
+  struct NodeArrays {
+    double *records, *velocities, *volumes;
+    const ContactFields<D>* fields;
+    const uint16_t* body;
+    LOAM_FORCE_INLINE double* record(size_t i) const { return records + offset(i, S); }
+    LOAM_FORCE_INLINE double* velocity(size_t i) const { return velocities + offset(i, D); }
+    LOAM_FORCE_INLINE double* volume(size_t i) const { return volumes + offset(i, G); }
+    LOAM_FORCE_INLINE size_t offset(size_t i, int width) const {
+      if constexpr (FIELDS == Fields::kShared) return 0;
+      return fields->offset(body, i, width);
+    }
+  };
+  template <Fields FIELDS>
+  NodeArrays<FIELDS> node_arrays(const Particles<D>& P) {
+    if constexpr (FIELDS == Fields::kShared)
+      return {node_.data(), vel_.data(), nullptr, nullptr, nullptr};
+    return {contact_.records(), contact_.velocities(), contact_.volumes(), &contact_,
+            P.body.data()};
   }
 
   // ------------------------------------------------------------------ the phases
   /// P2G over every set: mass and momentum (MOMENTUM), internal, gravity and external forces
-  /// (FORCE), all sets summed onto the one node record.
-  template <int NPP, bool MOMENTUM, bool FORCE>
+  /// (FORCE), all sets summed onto the one node record (with contact: onto their bodies'
+  /// fields, with their volume and its gradient).
+  template <int NPP, bool MOMENTUM, bool FORCE, Fields FIELDS>
   void scatter_all(Simulation<D>& sim) {
     // APIC's P2G is its own instantiation per form: the FLIP loop stays as it is without it.
+    // Contact takes FLIP only (setup).
     sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
       affine_.template evaluate_with_form<NPP>(
           sim, s.particles, b, c, scratch_[size_t(t)]->stencil, MOMENTUM && B_ >= 0,
           [&](auto form) {
-            scatter<NPP, MOMENTUM, FORCE, decltype(form)::value>(sim, s, b, c, t);
+            constexpr AffineForm FORM = decltype(form)::value;
+            if constexpr (FIELDS == Fields::kShared || FORM == AffineForm::kOff)
+              scatter<NPP, MOMENTUM, FORCE, FORM, FIELDS>(sim, s, b, c, t);
           });
     });
   }
   /// G2P velocity update (FLIP/PIC, or APIC's: update_velocity_apic); with REMAP the new
   /// momentum is scattered into vel_ (MUSL), with MOVE the particles move with the updated grid
   /// velocity.
-  template <int NPP, bool REMAP, bool MOVE>
+  template <int NPP, bool REMAP, bool MOVE, Fields FIELDS>
   void update_velocities(Simulation<D>& sim, double dt) {
     auto f = [&](ParticleSet<D>& s, size_t b, int c, int t) {
-      if (!affine_on_) return update_velocity<NPP, REMAP, MOVE>(sim, s, dt, b, c, t);
+      if (FIELDS == Fields::kPerBody || !affine_on_)
+        return update_velocity<NPP, REMAP, MOVE, FIELDS>(sim, s, dt, b, c, t);
       StencilBlock<D>& st = scratch_[size_t(t)]->stencil;
       affine_.evaluate(sim, s.particles, b, c, st);
       affine_.template with_form<NPP>(st, [&](auto form) {
@@ -221,17 +312,17 @@ class SinglePhase : public Scheme<D> {
     kUpdated,   // USL: L, move and FLIP update all from the updated grid record, in one pass
                 // (with APIC the velocities are already updated: L and move only)
   };
-  template <int NPP, Gradient MODE>
+  template <int NPP, Gradient MODE, Fields FIELDS>
   void update_stresses(Simulation<D>& sim, double dt) {
     sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
-      update_stress<NPP, MODE>(sim, s, dt, b, c, t);
+      update_stress<NPP, MODE, FIELDS>(sim, s, dt, b, c, t);
     });
   }
 
   // ------------------------------------------------------------------ kernels
   /// Particle-to-grid for one evaluated block: mass and momentum (MOMENTUM; with an affine
   /// FORM: APIC's), forces (FORCE).
-  template <int NPP, bool MOMENTUM, bool FORCE, AffineForm FORM>
+  template <int NPP, bool MOMENTUM, bool FORCE, AffineForm FORM, Fields FIELDS>
   [[gnu::noinline]] void scatter(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count,
                                  int thread) {
     constexpr bool AFFINE = FORM != AffineForm::kOff;
@@ -247,13 +338,15 @@ class SinglePhase : public Scheme<D> {
       fe[size_t(d)] = sim.external_force >= 0 ? P.col(sim.external_force, d) + b : nullptr;
     }
     for (int c = 0; c < NS; ++c) sig[size_t(c)] = P.col(P.stress, c) + b;
-    double* g = node_.data();
     const std::array<double, D> gravity = sim.gravity;
     typename AffineTransfer<D>::Stencil as;
     typename AffineTransfer<D>::template Momenta<NPP, FORM> am;  // APIC: momenta per weight
     typename AffineTransfer<D>::Columns Bp;
     if constexpr (AFFINE) Bp = AffineTransfer<D>::columns(P, B_);
+    const auto nodes = node_arrays<FIELDS>(P);
     for (int p = 0; p < count; ++p) {
+      double* g = nodes.record(b + size_t(p));
+      double* volume = nodes.volume(b + size_t(p));  // with contact: volume and its gradient
       // Particle values in locals: the node stores below could alias the particle columns.
       const double mp = m[p];
       double mv[D], body[D], sv[D][D];
@@ -276,6 +369,13 @@ class SinglePhase : public Scheme<D> {
         if constexpr (MOMENTUM) {
           r[kMass] += w * mp;
           for (int d = 0; d < D; ++d) r[kMomentum + d] += w * momentum(d);
+          if constexpr (FIELDS == Fields::kPerBody) {
+            double* vI = volume + size_t(st.node[kp]) * G;
+            vI[ContactFields<D>::kVolume] += w * V[p];
+            for (int d = 0; d < D; ++d)
+              vI[ContactFields<D>::kGradient + d] +=
+                  V[p] * st.grad[(size_t(k) * D + size_t(d)) * kBlock + size_t(p)];
+          }
         }
         if constexpr (FORCE) {
           double gr[D];
@@ -301,6 +401,7 @@ class SinglePhase : public Scheme<D> {
   /// Nodal forces to updated velocity and acceleration, with loads, face forces, damping and
   /// the boundary conditions: v^{n+1} = (p + dt f) / m, a = f / m; a node lighter than
   /// mass_tolerance keeps p / m without acceleration (light_node_velocity_scale).
+  template <Fields FIELDS>
   void update_nodes(Simulation<D>& sim, double dt) {
     sim.apply_grid_loads(node_vector(kForce));
     GridForces forces;
@@ -333,6 +434,7 @@ class SinglePhase : public Scheme<D> {
     u.phases[0] = {node_vector(kMomentum), node_vector(kForce), node_vector(kMass)};
     u.dt = dt;
     sim.constrain_update(u);
+    if constexpr (FIELDS == Fields::kPerBody) contact_.update(sim, node_.data(), dt);
   }
 
   /// Velocity from momentum in vel_ (MUSL re-map, USF), constrained: every node with mass
@@ -352,7 +454,7 @@ class SinglePhase : public Scheme<D> {
 
   /// Grid-to-particle velocity update of one block (FLIP/PIC blend); REMAP and MOVE as in
   /// update_velocities (a move never crosses a held face: Simulation::held_faces).
-  template <int NPP, bool REMAP, bool MOVE>
+  template <int NPP, bool REMAP, bool MOVE, Fields FIELDS>
   void update_velocity(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
                        int thread) {
     Particles<D>& P = set.particles;
@@ -366,13 +468,14 @@ class SinglePhase : public Scheme<D> {
       v[size_t(d)] = P.col(P.velocity, d) + b;
       x[size_t(d)] = P.col(P.position, d) + b;
     }
-    const double* g = node_.data();
-    double* remap = vel_.data();
     // Locals, not members: the stores through v and x could alias them and force reloads.
     const double flip = flip_;
     const HeldFaces<D> walls = sim.held_faces;
     double max_v2 = sc.max_v2, loss = 0;
+    const auto nodes = node_arrays<FIELDS>(P);
     for (int p = 0; p < count; ++p) {
+      const double* g = nodes.record(b + size_t(p));
+      double* remap = nodes.velocity(b + size_t(p));
       double a[D] = {}, vn[D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);
@@ -469,7 +572,7 @@ class SinglePhase : public Scheme<D> {
 
   /// Velocity gradient, volume and F update, optional move / velocity update, and the
   /// material's stress update for one block.
-  template <int NPP, Gradient MODE>
+  template <int NPP, Gradient MODE, Fields FIELDS>
   void update_stress(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
                      int thread) {
     constexpr bool kMove = MODE != Gradient::kCurrent;
@@ -486,10 +589,7 @@ class SinglePhase : public Scheme<D> {
       x[size_t(d)] = P.col(P.position, d) + b;
       v[size_t(d)] = P.col(P.velocity, d) + b;
     }
-    const double* g = node_.data();
     const auto F = deformation_gradient_block(P, F_, b);
-    // Source of the velocity field whose gradient is taken.
-    const double* vel = kFromRecord ? node_.data() + kMomentum : vel_.data();
     const size_t vstride = kFromRecord ? S : D;
     const double flip = flip_;
     const bool apic = affine_on_;  // USL with APIC: the velocities are updated already
@@ -499,7 +599,11 @@ class SinglePhase : public Scheme<D> {
     const bool store_C = MODE == Gradient::kCurrent && B_ >= 0 && affine_.needs_usf();
     typename AffineTransfer<D>::Columns C;
     if (store_C) C = AffineTransfer<D>::columns(P, B_);
+    const auto nodes = node_arrays<FIELDS>(P);
     for (int p = 0; p < count; ++p) {
+      const double* g = nodes.record(b + size_t(p));
+      // Source of the velocity field whose gradient is taken.
+      const double* vel = kFromRecord ? g + kMomentum : nodes.velocity(b + size_t(p));
       double l[D][D] = {}, vn[D] = {}, a[D] = {};
       for (int k = 0; k < npp; ++k) {
         const size_t kp = size_t(k) * kBlock + size_t(p);

@@ -86,7 +86,8 @@ TEST_CASE("every built-in plugin is one file named as its YAML type, in its kind
       {"drag", "plugins/drag"},      {"generator", "plugins/generators"},
       {"field", "plugins/fields"},   {"reference", "plugins/references"},
       {"writer", "plugins/writers"}, {"source", "plugins/sources"},
-      {"sink", "plugins/sinks"},     {"time_function", "plugins/time_functions"}};
+      {"sink", "plugins/sinks"},     {"time_function", "plugins/time_functions"},
+      {"contact", "plugins/contact"}};
   auto& reg = loam::Registry::instance();
   int checked = 0;
   for (const auto& k : reg.kinds()) {

@@ -1,0 +1,323 @@
+#pragma once
+// Multi-velocity-field contact (Bardenhagen et al. 2000, 2001; docs/contact.md). Each body in
+// contact scatters its mass, momentum and forces, its nodal volume sum_p V_p N_I(x_p) and the
+// volume gradient g = sum_p V_p grad N_I(x_p) onto a field of its own; the bodies not in contact
+// share one. The centre record (the sum of the fields) gets the loads, face forces, damping and
+// boundary conditions as without contact; then at every node where two fields have mass
+//   v_f* = (p_f + dt f_f) / m_f,
+//   v_f  = v_f* + (v_cm - sum_f m_f v_f* / m)    (what the centre got beyond the fields' forces),
+// the components a condition holds are set to the centre's, and each pair of fields exchanges
+// momentum by the contact law (framework/contact.hpp) along one normal n from a towards b (one
+// for both, so the exchange conserves momentum exactly): the outward normal g / |g| of the field
+// with the larger nodal volume, g_a or -g_b (grad N_I(x_p) at a node outside a body points away
+// from it), among the choices Nairn (2013, "Modeling imperfect interfaces in the material point
+// method using multimaterial methods") compares. The flat face of one body then sets the normal
+// where the corner of the other reaches the node; the mean of the two normals, or the larger
+// gradient, made that corner a ramp (a block sliding over a slab hopped at each cell it crossed).
+// A pair not in contact moves with its centre of mass. A node with one field keeps the centre's
+// velocity and acceleration, so away from contact the particles see the shared field bitwise.
+// The particles of a field take its velocity and acceleration a_f = (v_f - p_f / m_f) / dt.
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "contact.hpp"
+#include "diagnostics.hpp"
+#include "grid.hpp"
+#include "simulation.hpp"
+#include "step_blocks.hpp"
+
+namespace loam {
+
+/// Whether a kernel's particles share the one nodal record or each body in contact has its own.
+enum class Fields { kShared, kPerBody };
+
+template <int D>
+class ContactFields {
+ public:
+  /// The node record of a field, as the single-phase scheme's: mass, momentum (D), force (D);
+  /// after the update the momentum slot holds the velocity, the force slot the acceleration.
+  static constexpr int kMass = 0, kMomentum = 1, kForce = 1 + D, S = 1 + 2 * D;
+  /// Per node and field, the volume sum_p V_p N_I(x_p) and its gradient sum_p V_p grad N_I(x_p).
+  static constexpr int kVolume = 0, kGradient = 1, G = 1 + D;
+
+  bool on() const { return law_ != nullptr; }
+
+  /// One field per body named by the law (every body if it names none), one shared by the rest;
+  /// unknown names are located errors at `where`.
+  void setup(Simulation<D>& sim, const Params& where, Diagnostics& diag) {
+    law_ = sim.contact.get();
+    nodes_ = sim.grid.num_nodes;
+    cell_volume_ = 1;
+    for (int d = 0; d < D; ++d) cell_volume_ *= sim.grid.cell[d];
+    const auto& names = law_->bodies();
+    std::vector<uint8_t> listed(sim.bodies.size(), names.empty() ? 1 : 0);
+    for (size_t i = 0; i < names.size(); ++i) {
+      size_t b = 0;
+      while (b < sim.bodies.size() && sim.bodies[b].name != names[i]) ++b;
+      if (b == sim.bodies.size())
+        diag.error(where.where("bodies", i), where.path("bodies") + "." + std::to_string(i),
+                   "no body named '" + names[i] + "'");
+      else
+        listed[b] = 1;
+    }
+    field_of_body_.assign(sim.bodies.size(), 0);
+    bool shared = false;
+    for (uint8_t l : listed) shared = shared || !l;
+    fields_ = shared ? 1 : 0;
+    touches_.assign(1, 0);
+    for (size_t b = 0; b < sim.bodies.size(); ++b)
+      if (listed[b]) {
+        field_of_body_[b] = fields_++;
+        touches_.resize(size_t(fields_), 0);
+        touches_.back() = 1;
+      }
+    if (fields_ > kMaxFields)
+      diag.error(where.where("bodies"), where.path("bodies"),
+                 "at most " + std::to_string(kMaxFields) +
+                     " velocity fields: the bodies in contact and one for the others");
+    if (diag.ok() && fields_ - (shared ? 1 : 0) < 2)
+      diag.error(where.where("bodies"), where.path("bodies"),
+                 "contact needs two bodies at least (a body is in contact with the others)");
+    if (!diag.ok()) return;
+    rec_.assign(size_t(fields_) * nodes_ * S, 0.0);
+    volume_.assign(size_t(fields_) * nodes_ * G, 0.0);
+    vel_.assign(size_t(fields_) * nodes_ * D, 0.0);
+    touching_.assign(nodes_, 0);
+  }
+
+  /// Offset of particle i's field in an array of `width` values per node and field.
+  size_t offset(const uint16_t* body, size_t i, int width) const {
+    return size_t(field_of_body_[body[i]]) * nodes_ * size_t(width);
+  }
+  double* records() { return rec_.data(); }
+  double* volumes() { return volume_.data(); }
+  double* velocities() { return vel_.data(); }
+
+  /// Zero the records and volumes (a new scatter); `velocities` too for a re-map.
+  void zero_records(int threads) {
+    zero_nodes(rec_, threads);
+    zero_nodes(volume_, threads);
+  }
+  void zero_velocities(int threads) { zero_nodes(vel_, threads); }
+
+  /// Complete the fields' sums over the ranks: record slots [first, first + width), with the
+  /// volumes when `volumes`.
+  void complete(Simulation<D>& sim, int first, int width, bool volumes) {
+    std::vector<NodalArray> a;
+    for (int f = 0; f < fields_; ++f) {
+      a.push_back({rec_.data() + size_t(f) * nodes_ * S, S, width, first});
+      if (volumes) a.push_back({volume_.data() + size_t(f) * nodes_ * G, G, G});
+    }
+    sim.complete_nodes(a);
+  }
+  /// Complete the re-mapped momenta in velocities() over the ranks.
+  void complete_velocities(Simulation<D>& sim) {
+    std::vector<NodalArray> a;
+    for (int f = 0; f < fields_; ++f) a.push_back({vel_.data() + size_t(f) * nodes_ * D, D, D});
+    sim.complete_nodes(a);
+  }
+  /// The centre record's slots [first, first + width) as the sum of the fields'.
+  void sum_into(double* centre, int first, int width, int threads) const {
+    const int F = fields_;
+    const double* rec = rec_.data();
+    const size_t region = nodes_ * S;
+    for_each_node(nodes_, threads, [=](size_t n) {
+      for (int s = first; s < first + width; ++s) {
+        double sum = 0;
+        for (int f = 0; f < F; ++f) sum += rec[size_t(f) * region + n * S + size_t(s)];
+        centre[n * S + size_t(s)] = sum;
+      }
+    });
+  }
+
+  /// The fields' updated velocities and accelerations from the centre's (updated and
+  /// constrained: velocity in its momentum slot, acceleration in its force slot), the header's
+  /// equations; the contact's work goes to the energy ledger.
+  void update(Simulation<D>& sim, const double* centre, double dt) {
+    const double tol = sim.mass_tolerance;
+    const HeldComponents& held = sim.held(0);
+    const int F = fields_;
+    const size_t region = nodes_ * S;
+    double* rec = rec_.data();
+    EnergyLedger<D>& ledger = sim.ledger;
+    uint8_t* touching = touching_.data();
+    for_each_node(nodes_, sim.threads, [&, F, region, rec, tol, dt, touching](size_t n) {
+      touching[n] = 0;
+      const double* c = centre + n * S;
+      double m[kMaxFields], v[kMaxFields][D], vn[kMaxFields][D];
+      int with_mass = 0;
+      for (int f = 0; f < F; ++f) {
+        const double* r = rec + size_t(f) * region + n * S;
+        m[f] = r[kMass] > tol ? r[kMass] : 0.0;
+        with_mass += m[f] > 0;
+        for (int d = 0; d < D; ++d) {
+          vn[f][d] = m[f] > 0 ? r[kMomentum + d] / m[f] : c[kMomentum + d];
+          v[f][d] = m[f] > 0 ? vn[f][d] + dt * r[kForce + d] / m[f] : c[kMomentum + d];
+        }
+      }
+      if (with_mass > 1 && c[kMass] > tol) {
+        follow_centre(c, m, v, F);
+        for (int d = 0; d < D; ++d)
+          if (held.held(n, d))
+            for (int f = 0; f < F; ++f) v[f][d] = c[kMomentum + d];
+        double before[kMaxFields][D];
+        std::copy(&v[0][0], &v[0][0] + F * D, &before[0][0]);
+        exchange_at(n, held, c, m, v);
+        for (int f = 0; f < F; ++f)
+          for (int d = 0; d < D; ++d) touching[n] |= v[f][d] != before[f][d];
+        if (ledger.enabled) ledger.add_contact(n, contact_dissipation(m, vn, before, v, F));
+      }
+      for (int f = 0; f < F; ++f) {
+        double* r = rec + size_t(f) * region + n * S;
+        const bool own = with_mass > 1 && c[kMass] > tol && m[f] > 0;
+        for (int d = 0; d < D; ++d) {
+          r[kMomentum + d] = own ? v[f][d] : c[kMomentum + d];
+          r[kForce + d] = own ? (v[f][d] - vn[f][d]) / dt : c[kForce + d];
+        }
+      }
+    });
+  }
+
+  /// The fields' velocities p_f / m_f, constrained, with the contact exchange, into
+  /// velocities(): from the record's momentum slot before the grid update (`kRecord`, USF),
+  /// the law judging the approach; or from the re-mapped momenta in velocities() (`kRemap`,
+  /// MUSL) at the nodes where the update found the fields in contact, the law told so. Judged
+  /// again, the re-map lets a node go that the update held: the strain then disagrees with the
+  /// motion (two elastic bars rebounded with 40 % more energy than they had). Taking the
+  /// update's velocities there instead is USL's light-node instability (f / m at a node two
+  /// bodies barely reach).
+  enum class Momentum { kRecord, kRemap };
+  void velocities_from_momenta(Simulation<D>& sim, Momentum source) {
+    const double tol = sim.mass_tolerance;
+    const int F = fields_;
+    const size_t region = nodes_ * S;
+    const double* rec = rec_.data();
+    double* vel = vel_.data();
+    const bool remap = source == Momentum::kRemap;
+    for_each_node(nodes_, sim.threads, [=, this](size_t n) {
+      for (int f = 0; f < F; ++f) {
+        const double* r = rec + size_t(f) * region + n * S;
+        double* v = vel + (size_t(f) * nodes_ + n) * D;
+        for (int d = 0; d < D; ++d)
+          v[d] = node_velocity(remap ? v[d] : r[kMomentum + d], r[kMass], tol);
+      }
+    });
+    constrain_velocities(sim);
+    const uint8_t* touching = touching_.data();
+    for_each_node(nodes_, sim.threads, [=, this](size_t n) {
+      double m[kMaxFields], v[kMaxFields][D];
+      int with_mass = 0;
+      for (int f = 0; f < F; ++f) {
+        m[f] = rec[size_t(f) * region + n * S + kMass];
+        m[f] = m[f] > tol ? m[f] : 0.0;
+        with_mass += m[f] > 0;
+        for (int d = 0; d < D; ++d) v[f][d] = vel[(size_t(f) * nodes_ + n) * D + size_t(d)];
+      }
+      if (with_mass < 2 || (remap && !touching[n])) return;
+      exchange_pairs(n, m, v, remap ? Approach::kFound : Approach::kJudged);
+      for (int f = 0; f < F; ++f)
+        if (m[f] > 0)
+          for (int d = 0; d < D; ++d) vel[(size_t(f) * nodes_ + n) * D + size_t(d)] = v[f][d];
+    });
+    constrain_velocities(sim);  // the exchange may have moved a held component
+  }
+
+ private:
+  const Contact<D>* law_ = nullptr;
+  int fields_ = 0;
+  size_t nodes_ = 0;
+  double cell_volume_ = 1;  // h^D
+  std::vector<int> field_of_body_;
+  std::vector<uint8_t> touches_;   // per field: in contact with the other such fields
+  std::vector<double> rec_;        // fields * nodes * S
+  std::vector<double> volume_;     // fields * nodes * G: volume and volume gradient
+  std::vector<uint8_t> touching_;  // per node: the last update's exchange changed a velocity
+  std::vector<double> vel_;        // fields * nodes * D: re-mapped momenta, then velocities
+
+  static constexpr int kMaxFields = 8;
+  /// A field with less volume at a node than this share of a cell's takes no part in contact
+  /// there (pair_normal).
+  static constexpr double kMinShare = 0.02;
+
+  void constrain_velocities(Simulation<D>& sim) {
+    for (int f = 0; f < fields_; ++f)
+      sim.constrain(NodalVector{vel_.data() + size_t(f) * nodes_ * D, D, 0});
+  }
+
+  /// Shift the fields' velocities so that their centre of mass moves with the centre's updated
+  /// velocity (the loads, face forces, damping and conditions the centre got).
+  static void follow_centre(const double* c, const double* m, double (*v)[D], int F) {
+    double mass = 0, mv[D] = {};
+    for (int f = 0; f < F; ++f) {
+      mass += m[f];
+      for (int d = 0; d < D; ++d) mv[d] += m[f] * v[f][d];
+    }
+    for (int d = 0; d < D; ++d) {
+      const double shift = c[kMomentum + d] - mv[d] / mass;
+      for (int f = 0; f < F; ++f)
+        if (m[f] > 0) v[f][d] += shift;
+    }
+  }
+  /// Every two fields with mass exchange momentum: by the law where both are in contact (and a
+  /// normal is found), else they move with their centre of mass.
+  void exchange_pairs(size_t node, const double* m, double (*v)[D], Approach approach) const {
+    for (int a = 0; a < fields_; ++a)
+      for (int b = a + 1; b < fields_; ++b) {
+        if (!(m[a] > 0 && m[b] > 0)) continue;
+        double n[D];
+        if (!touches_[size_t(a)] || !touches_[size_t(b)])
+          bond(m[a], m[b], v[a], v[b]);
+        else if (pair_normal(node, a, b, n))
+          law_->exchange(m[a], m[b], v[a], v[b], n, approach);
+      }
+  }
+  /// The exchange at node n, then the held components set to the centre's v_c again.
+  void exchange_at(size_t n, const HeldComponents& held, const double* c, const double* m,
+                   double (*v)[D]) const {
+    exchange_pairs(n, m, v, Approach::kJudged);
+    for (int d = 0; d < D; ++d)
+      if (held.held(n, d))
+        for (int f = 0; f < fields_; ++f) v[f][d] = c[kMomentum + d];
+  }
+  static void bond(double ma, double mb, double (&va)[D], double (&vb)[D]) {
+    for (int d = 0; d < D; ++d) va[d] = vb[d] = (ma * va[d] + mb * vb[d]) / (ma + mb);
+  }
+  /// The unit normal from field a towards field b at `node`: the outward normal g / |g| of the
+  /// field with the larger nodal volume there (a flat face rather than the corner of the other
+  /// body that reaches the node). False where the other field's volume is below kMinShare of a
+  /// cell's, or the gradient is zero: the pair then moves freely there. A quadratic stencil
+  /// reaches a row of nodes into the other body, where the side faces of that body would give
+  /// the normal (a block on a slab stuck to it).
+  bool pair_normal(size_t node, int a, int b, double (&n)[D]) const {
+    const double* ga = volume_.data() + (size_t(a) * nodes_ + node) * G;
+    const double* gb = volume_.data() + (size_t(b) * nodes_ + node) * G;
+    if (std::min(ga[kVolume], gb[kVolume]) < kMinShare * cell_volume_) return false;
+    const bool from_a = ga[kVolume] >= gb[kVolume];
+    const double* g = (from_a ? ga : gb) + kGradient;
+    double len2 = 0;
+    for (int d = 0; d < D; ++d) len2 += g[d] * g[d];
+    if (!(len2 > 0)) return false;
+    const double scale = (from_a ? 1 : -1) / std::sqrt(len2);
+    for (int d = 0; d < D; ++d) n[d] = scale * g[d];
+    return true;
+  }
+  /// The kinetic energy the contact forces took from the fields: minus their work
+  /// m_f dv_f . (v_f^n + v_f^{n+1}) / 2 (the ledger's mid-step rule).
+  static double contact_dissipation(const double* m, const double (*vn)[D],
+                                    const double (*before)[D], const double (*after)[D], int F) {
+    double work = 0;
+    for (int f = 0; f < F; ++f)
+      for (int d = 0; d < D; ++d)
+        work += m[f] * (after[f][d] - before[f][d]) * 0.5 * (vn[f][d] + after[f][d]);
+    return -work;
+  }
+};
+
+}  // namespace loam
