@@ -44,7 +44,9 @@ class HeldComponents {
     if (!b) marked_.push_back(node);
     b = uint8_t(b | (1u << d));
   }
-  bool held(size_t node, int d) const { return (bits_[node] >> d) & 1u; }
+  bool held(size_t node, int d) const {
+    return node < bits_.size() && ((bits_[node] >> d) & 1u);  // none before the first update
+  }
   /// Nothing held, on a grid of num_nodes nodes.
   void clear(size_t num_nodes) {
     if (bits_.size() != num_nodes) {

@@ -211,7 +211,8 @@ class ContactFields {
     });
     constrain_velocities(sim);
     const uint8_t* touching = touching_.data();
-    for_each_node(nodes_, sim.threads, [=, this](size_t n) {
+    const HeldComponents& held = sim.held(0);
+    for_each_node(nodes_, sim.threads, [=, this, &held](size_t n) {
       double m[kMaxFields], v[kMaxFields][D];
       int with_mass = 0;
       for (int f = 0; f < F; ++f) {
@@ -221,7 +222,7 @@ class ContactFields {
         for (int d = 0; d < D; ++d) v[f][d] = vel[(size_t(f) * nodes_ + n) * D + size_t(d)];
       }
       if (with_mass < 2 || (remap && !touching[n])) return;
-      exchange_pairs(n, m, v, remap ? Approach::kFound : Approach::kJudged);
+      exchange_pairs(n, m, v, remap ? Approach::kFound : Approach::kJudged, held);
       for (int f = 0; f < F; ++f)
         if (m[f] > 0)
           for (int d = 0; d < D; ++d) vel[(size_t(f) * nodes_ + n) * D + size_t(d)] = v[f][d];
@@ -267,21 +268,22 @@ class ContactFields {
   }
   /// Every two fields with mass exchange momentum: by the law where both are in contact (and a
   /// normal is found), else they move with their centre of mass.
-  void exchange_pairs(size_t node, const double* m, double (*v)[D], Approach approach) const {
+  void exchange_pairs(size_t node, const double* m, double (*v)[D], Approach approach,
+                      const HeldComponents& held) const {
     for (int a = 0; a < fields_; ++a)
       for (int b = a + 1; b < fields_; ++b) {
         if (!(m[a] > 0 && m[b] > 0)) continue;
         double n[D];
         if (!touches_[size_t(a)] || !touches_[size_t(b)])
           bond(m[a], m[b], v[a], v[b]);
-        else if (pair_normal(node, a, b, n))
+        else if (pair_normal(node, a, b, held, n))
           law_->exchange(m[a], m[b], v[a], v[b], n, approach);
       }
   }
   /// The exchange at node n, then the held components set to the centre's v_c again.
   void exchange_at(size_t n, const HeldComponents& held, const double* c, const double* m,
                    double (*v)[D]) const {
-    exchange_pairs(n, m, v, Approach::kJudged);
+    exchange_pairs(n, m, v, Approach::kJudged, held);
     for (int d = 0; d < D; ++d)
       if (held.held(n, d))
         for (int f = 0; f < fields_; ++f) v[f][d] = c[kMomentum + d];
@@ -294,18 +296,23 @@ class ContactFields {
   /// body that reaches the node). False where the other field's volume is below kMinShare of a
   /// cell's, or the gradient is zero: the pair then moves freely there. A quadratic stencil
   /// reaches a row of nodes into the other body, where the side faces of that body would give
-  /// the normal (a block on a slab stuck to it).
-  bool pair_normal(size_t node, int a, int b, double (&n)[D]) const {
+  /// the normal (a block on a slab stuck to it). The components a condition holds at the node
+  /// are left out: a body cut by a held face (a symmetry plane) has a spurious gradient across
+  /// it, which tilted the normal and slowed a block sliding along a slip face by 1.5 %.
+  bool pair_normal(size_t node, int a, int b, const HeldComponents& held, double (&n)[D]) const {
     const double* ga = volume_.data() + (size_t(a) * nodes_ + node) * G;
     const double* gb = volume_.data() + (size_t(b) * nodes_ + node) * G;
     if (std::min(ga[kVolume], gb[kVolume]) < kMinShare * cell_volume_) return false;
     const bool from_a = ga[kVolume] >= gb[kVolume];
     const double* g = (from_a ? ga : gb) + kGradient;
     double len2 = 0;
-    for (int d = 0; d < D; ++d) len2 += g[d] * g[d];
+    for (int d = 0; d < D; ++d) {
+      n[d] = held.held(node, d) ? 0.0 : g[d];
+      len2 += n[d] * n[d];
+    }
     if (!(len2 > 0)) return false;
     const double scale = (from_a ? 1 : -1) / std::sqrt(len2);
-    for (int d = 0; d < D; ++d) n[d] = scale * g[d];
+    for (int d = 0; d < D; ++d) n[d] *= scale;
     return true;
   }
   /// The kinetic energy the contact forces took from the fields: minus their work

@@ -88,6 +88,12 @@ class SinglePhase : public Scheme<D> {
         diag.error(params_.where("transfer"), params_.path("transfer"),
                    "contact between bodies takes transfer: flip (the affine moments of two "
                    "velocity fields are not implemented)");
+      if (update_ == "usl" && !sim.shape->stencil_covers_domain())
+        diag.error(params_.where("update"), params_.path("update"),
+                   "contact with update: usl needs a shape function whose stencil covers the "
+                   "particle's domain (gimp, cpdi, bspline2): with linear tents a node that one "
+                   "body barely reaches takes its own f / m and the run blows up (a block on a "
+                   "slab at 0.1 s); use musl or usf");
     }
     vel_.assign(sim.grid.num_nodes * D, 0.0);
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
