@@ -125,16 +125,11 @@ class ContactFields {
   }
   /// The centre record's slots [first, first + width) as the sum of the fields'.
   void sum_into(double* centre, int first, int width, int threads) const {
-    const int F = fields_;
-    const double* rec = rec_.data();
-    const size_t region = nodes_ * S;
-    for_each_node(nodes_, threads, [=](size_t n) {
-      for (int s = first; s < first + width; ++s) {
-        double sum = 0;
-        for (int f = 0; f < F; ++f) sum += rec[size_t(f) * region + n * S + size_t(s)];
-        centre[n * S + size_t(s)] = sum;
-      }
-    });
+    sum_fields(rec_.data(), S, first, width, centre, threads);
+  }
+  /// The fields' re-mapped momenta summed into `centre` (D per node): the shared field's.
+  void sum_remapped_into(double* centre, int threads) const {
+    sum_fields(vel_.data(), D, 0, D, centre, threads);
   }
 
   /// The fields' updated velocities and accelerations from the centre's (updated and
@@ -247,6 +242,19 @@ class ContactFields {
   /// there (pair_normal).
   static constexpr double kMinShare = 0.02;
 
+  /// dst[n * stride + s] = sum over the fields of src's, for s in [first, first + width).
+  void sum_fields(const double* src, int stride, int first, int width, double* dst,
+                  int threads) const {
+    const int F = fields_;
+    const size_t region = nodes_ * size_t(stride);
+    for_each_node(nodes_, threads, [=](size_t n) {
+      for (int s = first; s < first + width; ++s) {
+        double sum = 0;
+        for (int f = 0; f < F; ++f) sum += src[size_t(f) * region + n * size_t(stride) + size_t(s)];
+        dst[n * size_t(stride) + size_t(s)] = sum;
+      }
+    });
+  }
   void constrain_velocities(Simulation<D>& sim) {
     for (int f = 0; f < fields_; ++f)
       sim.constrain(NodalVector{vel_.data() + size_t(f) * nodes_ * D, D, 0});

@@ -235,15 +235,20 @@ class SinglePhase : public Scheme<D> {
   }
   template <Fields FIELDS>
   void zero_remap(Simulation<D>& sim) {
-    if constexpr (FIELDS == Fields::kPerBody) contact_.zero_velocities(sim.threads);
-    zero_nodes(vel_, sim.threads);
+    if constexpr (FIELDS == Fields::kPerBody)
+      contact_.zero_velocities(sim.threads);  // vel_ is their sum (remapped_velocities)
+    else
+      zero_nodes(vel_, sim.threads);
   }
   /// The re-mapped momenta to velocities (MUSL): the shared field's, and with contact each
   /// body's with the contact exchange.
   template <Fields FIELDS>
   void remapped_velocities(Simulation<D>& sim) {
     if constexpr (FIELDS == Fields::kPerBody) {
+      // The shared field's too: the grid output's velocity.
       contact_.complete_velocities(sim);
+      contact_.sum_remapped_into(vel_.data(), sim.threads);
+      momentum_to_velocity(sim, vel_.data(), D, 0);
       contact_.velocities_from_momenta(sim, ContactFields<D>::Momentum::kRemap);
     } else {
       sim.complete_nodes({{vel_.data(), D, D}});
