@@ -20,6 +20,8 @@ namespace loam {
 
 template <int D>
 class Simulation;
+template <int D>
+class RigidMotion;
 class Diagnostics;
 class Params;
 
@@ -176,6 +178,9 @@ class Boundary {
   /// Whether those nodes change from step to step (a rigid body's), so the reaction takes
   /// them anew each time. Default false.
   virtual bool reaction_nodes_move() const { return false; }
+  /// A condition that makes a body in contact rigid (framework/rigid_motion.hpp): the contact
+  /// fields move that body's field as one piece and report its reaction here. Default null.
+  virtual const RigidMotion<D>* rigid_motion() const { return nullptr; }
 };
 
 /// Set components `dirs` of `nodes` to `velocity` in the phases of u that `applies(k)` selects,

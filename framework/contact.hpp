@@ -23,7 +23,8 @@ class Contact {
   static constexpr const char* kind = "contact";
   virtual ~Contact() = default;
   /// Correct the velocities va, vb of two fields of masses ma, mb (both > 0) that meet at a
-  /// node; n is the unit normal pointing from body a towards body b. `approach`: whether the
+  /// node; n is the unit normal pointing from body a towards body b. mb is +infinity where b is
+  /// a rigid body (framework/rigid_motion.hpp): vb must then stay as it is. `approach`: whether the
   /// law judges from va, vb if the bodies approach (the grid update), or they were found
   /// approaching at this node in the step's update (the MUSL re-map: the law then acts as if
   /// they were, so that the strain follows the motion the update gave).

@@ -17,12 +17,19 @@
 // A pair not in contact moves with its centre of mass. A node with one field keeps the centre's
 // velocity and acceleration, so away from contact the particles see the shared field bitwise.
 // The particles of a field take its velocity and acceleration a_f = (v_f - p_f / m_f) / dt.
+//
+// A rigid body's field (framework/rigid_fields.hpp) stays out of the centre record and moves
+// as one piece; the other fields meet it as a body of infinite mass (the law gets m_b =
+// +infinity: the rigid field keeps its velocity, the other takes the whole exchange). Its
+// particles take PIC from it, so their velocities stay a rigid motion. Two rigid bodies pass
+// through each other.
 #include <omp.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -30,6 +37,7 @@
 #include "contact.hpp"
 #include "diagnostics.hpp"
 #include "grid.hpp"
+#include "rigid_fields.hpp"
 #include "simulation.hpp"
 #include "step_blocks.hpp"
 
@@ -82,16 +90,16 @@ class ContactFields {
       diag.error(where.where("bodies"), where.path("bodies"),
                  "at most " + std::to_string(kMaxFields) +
                      " velocity fields: the bodies in contact and one for the others");
-    if (diag.ok() && fields_ - (shared ? 1 : 0) < 2)
-      diag.error(where.where("bodies"), where.path("bodies"),
-                 "contact needs two bodies at least (a body is in contact with the others)");
     if (!diag.ok()) return;
+    rigid_.setup(sim.grid, fields_, field_of_body_);
     rec_.assign(size_t(fields_) * nodes_ * S, 0.0);
     volume_.assign(size_t(fields_) * nodes_ * G, 0.0);
     vel_.assign(size_t(fields_) * nodes_ * D, 0.0);
     touching_.assign(nodes_, 0);
   }
 
+  /// Whether particle i's body moves rigidly in this step.
+  bool rigid(const uint16_t* body, size_t i) const { return rigid_.body_is_rigid(body[i]); }
   /// Offset of particle i's field in an array of `width` values per node and field.
   size_t offset(const uint16_t* body, size_t i, int width) const {
     return size_t(field_of_body_[body[i]]) * nodes_ * size_t(width);
@@ -100,10 +108,12 @@ class ContactFields {
   double* volumes() { return volume_.data(); }
   double* velocities() { return vel_.data(); }
 
-  /// Zero the records and volumes (a new scatter); `velocities` too for a re-map.
-  void zero_records(int threads) {
-    zero_nodes(rec_, threads);
-    zero_nodes(volume_, threads);
+  /// A new step: the bodies that move rigidly in it (their conditions active now), their mass,
+  /// centre and inertia; the records and volumes zeroed for the scatter.
+  void begin_step(const Simulation<D>& sim) {
+    rigid_.find(sim);
+    zero_nodes(rec_, sim.threads);
+    zero_nodes(volume_, sim.threads);
   }
   void zero_velocities(int threads) { zero_nodes(vel_, threads); }
 
@@ -123,7 +133,8 @@ class ContactFields {
     for (int f = 0; f < fields_; ++f) a.push_back({vel_.data() + size_t(f) * nodes_ * D, D, D});
     sim.complete_nodes(a);
   }
-  /// The centre record's slots [first, first + width) as the sum of the fields'.
+  /// The centre record's slots [first, first + width) as the sum of the fields' (rigid bodies'
+  /// left out).
   void sum_into(double* centre, int first, int width, int threads) const {
     sum_fields(rec_.data(), S, first, width, centre, threads);
   }
@@ -136,6 +147,7 @@ class ContactFields {
   /// constrained: velocity in its momentum slot, acceleration in its force slot), the header's
   /// equations; the contact's work goes to the energy ledger.
   void update(Simulation<D>& sim, const double* centre, double dt) {
+    if (rigid_.any()) rigid_.predict(sim, rec_.data(), centre, dt);
     const double tol = sim.mass_tolerance;
     const HeldComponents& held = sim.held(0);
     const int F = fields_;
@@ -143,7 +155,8 @@ class ContactFields {
     double* rec = rec_.data();
     EnergyLedger<D>& ledger = sim.ledger;
     uint8_t* touching = touching_.data();
-    for_each_node(nodes_, sim.threads, [&, F, region, rec, tol, dt, touching](size_t n) {
+    const int* rigid = rigid_.of_field();
+    for_each_node(nodes_, sim.threads, [&, F, region, rec, tol, dt, touching, rigid](size_t n) {
       touching[n] = 0;
       const double* c = centre + n * S;
       double m[kMaxFields], v[kMaxFields][D], vn[kMaxFields][D];
@@ -156,12 +169,14 @@ class ContactFields {
           vn[f][d] = m[f] > 0 ? r[kMomentum + d] / m[f] : c[kMomentum + d];
           v[f][d] = m[f] > 0 ? vn[f][d] + dt * r[kForce + d] / m[f] : c[kMomentum + d];
         }
+        if (rigid[f] >= 0 && m[f] > 0) rigid_.velocity(f, n, v[f]);
       }
       if (with_mass > 1 && c[kMass] > tol) {
-        follow_centre(c, m, v, F);
+        follow_centre(c, m, v, F, rigid);
         for (int d = 0; d < D; ++d)
           if (held.held(n, d))
-            for (int f = 0; f < F; ++f) v[f][d] = c[kMomentum + d];
+            for (int f = 0; f < F; ++f)
+              if (rigid[f] < 0) v[f][d] = c[kMomentum + d];
         double before[kMaxFields][D];
         std::copy(&v[0][0], &v[0][0] + F * D, &before[0][0]);
         exchange_at(n, held, c, m, v);
@@ -170,6 +185,7 @@ class ContactFields {
         if (ledger.enabled) ledger.add_contact(n, contact_dissipation(m, vn, before, v, F));
       }
       for (int f = 0; f < F; ++f) {
+        if (rigid[f] >= 0) continue;  // RigidFields::correct
         double* r = rec + size_t(f) * region + n * S;
         const bool own = with_mass > 1 && c[kMass] > tol && m[f] > 0;
         for (int d = 0; d < D; ++d) {
@@ -178,6 +194,7 @@ class ContactFields {
         }
       }
     });
+    if (rigid_.any()) rigid_.correct(sim, rec_.data(), dt);
   }
 
   /// The fields' velocities p_f / m_f, constrained, with the contact exchange, into
@@ -205,6 +222,7 @@ class ContactFields {
       }
     });
     constrain_velocities(sim);
+    rigid_.set_velocities(rec, vel, !remap);  // USF: the motion at t^n
     const uint8_t* touching = touching_.data();
     const HeldComponents& held = sim.held(0);
     for_each_node(nodes_, sim.threads, [=, this, &held](size_t n) {
@@ -217,9 +235,9 @@ class ContactFields {
         for (int d = 0; d < D; ++d) v[f][d] = vel[(size_t(f) * nodes_ + n) * D + size_t(d)];
       }
       if (with_mass < 2 || (remap && !touching[n])) return;
-      exchange_pairs(n, m, v, remap ? Approach::kFound : Approach::kJudged, held);
+      exchange_pairs(n, m, v, remap ? Approach::kFound : Approach::kJudged, held, nullptr);
       for (int f = 0; f < F; ++f)
-        if (m[f] > 0)
+        if (m[f] > 0 && !rigid_.field_is_rigid(f))
           for (int d = 0; d < D; ++d) vel[(size_t(f) * nodes_ + n) * D + size_t(d)] = v[f][d];
     });
     constrain_velocities(sim);  // the exchange may have moved a held component
@@ -236,6 +254,7 @@ class ContactFields {
   std::vector<double> volume_;     // fields * nodes * G: volume and volume gradient
   std::vector<uint8_t> touching_;  // per node: the last update's exchange changed a velocity
   std::vector<double> vel_;        // fields * nodes * D: re-mapped momenta, then velocities
+  RigidFields<D> rigid_;           // the fields of rigid bodies
 
   static constexpr int kMaxFields = 8;
   /// A field with less volume at a node than this share of a cell's takes no part in contact
@@ -247,57 +266,81 @@ class ContactFields {
                   int threads) const {
     const int F = fields_;
     const size_t region = nodes_ * size_t(stride);
+    const int* rigid = rigid_.of_field();
     for_each_node(nodes_, threads, [=](size_t n) {
       for (int s = first; s < first + width; ++s) {
         double sum = 0;
-        for (int f = 0; f < F; ++f) sum += src[size_t(f) * region + n * size_t(stride) + size_t(s)];
+        for (int f = 0; f < F; ++f)
+          if (rigid[f] < 0) sum += src[size_t(f) * region + n * size_t(stride) + size_t(s)];
         dst[n * size_t(stride) + size_t(s)] = sum;
       }
     });
   }
+  /// The conditions on each field's velocities (a rigid body's field takes them in its rows).
   void constrain_velocities(Simulation<D>& sim) {
     for (int f = 0; f < fields_; ++f)
-      sim.constrain(NodalVector{vel_.data() + size_t(f) * nodes_ * D, D, 0});
+      if (!rigid_.field_is_rigid(f))
+        sim.constrain(NodalVector{vel_.data() + size_t(f) * nodes_ * D, D, 0});
   }
 
   /// Shift the fields' velocities so that their centre of mass moves with the centre's updated
   /// velocity (the loads, face forces, damping and conditions the centre got).
-  static void follow_centre(const double* c, const double* m, double (*v)[D], int F) {
+  static void follow_centre(const double* c, const double* m, double (*v)[D], int F,
+                            const int* rigid) {
     double mass = 0, mv[D] = {};
     for (int f = 0; f < F; ++f) {
+      if (rigid[f] >= 0) continue;  // not in the centre record
       mass += m[f];
       for (int d = 0; d < D; ++d) mv[d] += m[f] * v[f][d];
     }
     for (int d = 0; d < D; ++d) {
       const double shift = c[kMomentum + d] - mv[d] / mass;
       for (int f = 0; f < F; ++f)
-        if (m[f] > 0) v[f][d] += shift;
+        if (m[f] > 0 && rigid[f] < 0) v[f][d] += shift;
     }
   }
   /// Every two fields with mass exchange momentum: by the law where both are in contact (and a
-  /// normal is found), else they move with their centre of mass.
+  /// normal is found), else they move with their centre of mass. A rigid body's field enters
+  /// as field b of infinite mass; the impulse the other field takes from it goes, reversed, to
+  /// `impulse` (fields * nodes * D) when given.
   void exchange_pairs(size_t node, const double* m, double (*v)[D], Approach approach,
-                      const HeldComponents& held) const {
+                      const HeldComponents& held, double* impulse) const {
+    constexpr double kRigid = std::numeric_limits<double>::infinity();
     for (int a = 0; a < fields_; ++a)
       for (int b = a + 1; b < fields_; ++b) {
         if (!(m[a] > 0 && m[b] > 0)) continue;
+        const bool rigid_a = rigid_.field_is_rigid(a), rigid_b = rigid_.field_is_rigid(b);
+        if (rigid_a && rigid_b) continue;
+        const int s = rigid_a ? b : a, t = rigid_a ? a : b;  // t: the rigid one, if either is
+        const double ms = m[s], mt = rigid_a || rigid_b ? kRigid : m[t];
+        double before[D] = {};
+        std::copy(v[s], v[s] + D, before);
         double n[D];
-        if (!touches_[size_t(a)] || !touches_[size_t(b)])
-          bond(m[a], m[b], v[a], v[b]);
-        else if (pair_normal(node, a, b, held, n))
-          law_->exchange(m[a], m[b], v[a], v[b], n, approach);
+        if (!touches_[size_t(a)] || !touches_[size_t(b)]) {
+          bond(ms, mt, v[s], v[t]);
+        } else if (pair_normal(node, a, b, held, n)) {
+          if (rigid_a)
+            for (int d = 0; d < D; ++d) n[d] = -n[d];  // from s towards t
+          law_->exchange(ms, mt, v[s], v[t], n, approach);
+        }
+        if (impulse && (rigid_a || rigid_b))
+          for (int d = 0; d < D; ++d)
+            impulse[(size_t(t) * nodes_ + node) * D + size_t(d)] -= ms * (v[s][d] - before[d]);
       }
   }
   /// The exchange at node n, then the held components set to the centre's v_c again.
   void exchange_at(size_t n, const HeldComponents& held, const double* c, const double* m,
-                   double (*v)[D]) const {
-    exchange_pairs(n, m, v, Approach::kJudged, held);
+                   double (*v)[D]) {
+    exchange_pairs(n, m, v, Approach::kJudged, held, rigid_.impulses());
     for (int d = 0; d < D; ++d)
       if (held.held(n, d))
-        for (int f = 0; f < fields_; ++f) v[f][d] = c[kMomentum + d];
+        for (int f = 0; f < fields_; ++f)
+          if (!rigid_.field_is_rigid(f)) v[f][d] = c[kMomentum + d];
   }
+  /// Both fields move with their centre of mass (mb infinite: with b).
   static void bond(double ma, double mb, double (&va)[D], double (&vb)[D]) {
-    for (int d = 0; d < D; ++d) va[d] = vb[d] = (ma * va[d] + mb * vb[d]) / (ma + mb);
+    for (int d = 0; d < D; ++d)
+      va[d] = vb[d] = std::isinf(mb) ? vb[d] : (ma * va[d] + mb * vb[d]) / (ma + mb);
   }
   /// The unit normal from field a towards field b at `node`: the outward normal g / |g| of the
   /// field with the larger nodal volume there (a flat face rather than the corner of the other

@@ -173,6 +173,11 @@ class EnergyLedger {
     if (enabled && (!distributed_ || owned_[n]))
       per_thread_[size_t(omp_get_thread_num())].contact += dissipated;
   }
+  /// Work the conditions did in this step that no nodal force records (a rigid body's
+  /// constraints, framework/contact_fields.hpp).
+  void add_boundary_work(double work) {
+    if (enabled) node_work_[size_t(NodalWork::kBoundaries)] += work;
+  }
   /// Kinetic energy the grid-to-particle update of the block of set `set` that begins at
   /// particle b took against FLIP.
   void add_transfer_loss(size_t set, size_t b, double loss) {

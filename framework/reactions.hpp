@@ -55,6 +55,7 @@ class Reactions {
   void begin_update(const std::vector<std::unique_ptr<Boundary<D>>>& active, const GridUpdate& u,
                     const Grid<D>& grid, const Ranks<D>& ranks) {
     if (owner_.size() != grid.num_nodes) owner_.assign(grid.num_nodes, -1);
+    for (size_t n : claimed_) owner_[n] = -1;
     claimed_.clear();
     for (const auto& b : active) {
       const auto it = entries_.find(b.get());
@@ -87,7 +88,14 @@ class Reactions {
           if (k == 0 && damped_ && held && da != 0) r[d] += damping_[n * D + size_t(d)];
         }
       }
-    for (size_t n : claimed_) owner_[n] = -1;
+  }
+  /// A force at node n (phase 0) that the condition credited with n in this step's update
+  /// applies beyond the nodal mass it measured (a rigid body held there,
+  /// framework/contact_fields.hpp); none if no reporting condition holds n.
+  void add_node_force(size_t n, const double (&force)[D]) {
+    if (n >= owner_.size() || owner_[n] < 0) return;
+    double* r = step_.data() + size_t(owner_[n]) * kValues;
+    for (int d = 0; d < D; ++d) r[d] += force[d];
   }
 
   /// Face forces (Boundary::add_forces, e.g. an absorbing face's free-field reaction): the
@@ -111,6 +119,15 @@ class Reactions {
       for (size_t j = 0; j < e.nodes.size(); ++j)
         for (int d = 0; d < D; ++d)
           r[k * D + d] += v[k]->at(e.nodes[j], d) - before_[(j * 2 + size_t(k)) * D + size_t(d)];
+  }
+
+  /// A force condition b measured itself in this step (a rigid body in contact: the force its
+  /// prescribed motion and the faces it touches apply to it), phase 0.
+  void add_force(const Boundary<D>* b, const double (&force)[D]) {
+    const auto it = entries_.find(b);
+    if (it == entries_.end()) return;
+    double* r = step_.data() + size_t(it->second.slot) * kValues;
+    for (int d = 0; d < D; ++d) r[d] += force[d];
   }
 
   /// Local damping acts on the nodal forces of phase 0 (the only phase or the skeleton): the

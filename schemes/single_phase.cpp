@@ -219,7 +219,7 @@ class SinglePhase : public Scheme<D> {
   /// A new scatter: the shared record, and the bodies' fields with contact.
   template <Fields FIELDS>
   void zero_records(Simulation<D>& sim) {
-    if constexpr (FIELDS == Fields::kPerBody) contact_.zero_records(sim.threads);
+    if constexpr (FIELDS == Fields::kPerBody) contact_.begin_step(sim);
     zero_nodes(node_, sim.threads);
   }
   /// The record slots [first, first + width) complete over the ranks; with contact the shared
@@ -266,6 +266,12 @@ class SinglePhase : public Scheme<D> {
     LOAM_FORCE_INLINE double* record(size_t i) const { return records + offset(i, S); }
     LOAM_FORCE_INLINE double* velocity(size_t i) const { return velocities + offset(i, D); }
     LOAM_FORCE_INLINE double* volume(size_t i) const { return volumes + offset(i, G); }
+    /// The FLIP share of particle i's velocity update: 0 for a rigid body's (PIC keeps its
+    /// particles' velocities a rigid motion), else the scheme's.
+    LOAM_FORCE_INLINE double flip(double blend, size_t i) const {
+      if constexpr (FIELDS == Fields::kShared) return blend;
+      return fields->rigid(body, i) ? 0.0 : blend;
+    }
     LOAM_FORCE_INLINE size_t offset(size_t i, int width) const {
       if constexpr (FIELDS == Fields::kShared) return 0;
       return fields->offset(body, i, width);
@@ -499,7 +505,7 @@ class SinglePhase : public Scheme<D> {
       }
       double v2 = 0, vp[D];
       for (int d = 0; d < D; ++d) {
-        vp[d] = flip_pic(flip, v[size_t(d)][p], dt, a[d], vn[d]);
+        vp[d] = flip_pic(nodes.flip(flip, b + size_t(p)), v[size_t(d)][p], dt, a[d], vn[d]);
         if (flip < 1) loss += m[p] * transfer_loss(v[size_t(d)][p], dt, a[d], vp[d]);
         v[size_t(d)][p] = vp[d];
         v2 += vp[d] * vp[d];
@@ -637,7 +643,7 @@ class SinglePhase : public Scheme<D> {
         for (int d = 0; d < D; ++d) {
           double& vp = v[size_t(d)][p];
           const double v_old = vp;
-          vp = flip_pic(flip, vp, dt, a[d], vn[d]);
+          vp = flip_pic(nodes.flip(flip, b + size_t(p)), vp, dt, a[d], vn[d]);
           if (flip < 1) loss += P.col(P.mass)[b + size_t(p)] * transfer_loss(v_old, dt, a[d], vp);
           v2 += vp * vp;
         }

@@ -245,9 +245,6 @@ TEST_CASE("contact: unknown bodies, a scheme without body fields and APIC are lo
   loam_test::check_located_error(dir.path, yaml,
                                  "run.yaml:", "contact.bodies.1: no body named 'blok'");
   yaml = incline(0.3, "linear");
-  yaml.replace(yaml.find("coefficient: 0.3"), 16, "coefficient: 0.3, bodies: [block]");
-  loam_test::check_located_error(dir.path, yaml, "run.yaml:", "contact needs two bodies");
-  yaml = incline(0.3, "linear");
   yaml.replace(yaml.find("update: musl}"), 13, "update: usf, transfer: apic}");
   loam_test::check_located_error(dir.path, yaml,
                                  "run.yaml:", "contact between bodies takes transfer: flip");

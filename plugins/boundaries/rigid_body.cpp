@@ -13,19 +13,29 @@
 // reaction (framework/reactions.hpp; `name`, default rigid_body_<position>) is the force on the
 // soil, the body's weight under gravity and its inertia m dv/dt (zero at a constant velocity);
 // a probe on one of its particles (particle_near, fields [displacement]) gives its displacement.
-// Limits: translation only; the contact is bonded (no separation, no Coulomb sliding between
-// the body and the soil); the body's material is not used but in the time step (its wave speed
-// counts: give the soil's stiffness, not steel's); serial runs only.
+// Limits of this bonded form: translation only; no separation, no Coulomb sliding between the
+// body and the soil; serial runs only.
+//
+// A body listed under `contact:` moves instead on its own velocity field as one piece
+// (framework/rigid_motion.hpp, framework/contact_fields.hpp): the contact law acts between it
+// and the other bodies (friction, separation), it translates and rotates, and the components
+// `directions` (default all for `motion: prescribed`, none for `motion: free`) follow the
+// prescribed velocity while the others (and the rotation, unless `rotation: fixed`) follow the
+// forces on it: gravity, its particle loads, the other bodies' contact, and the faces that hold
+// the nodes it reaches. Its reaction is then the force its prescribed components and those faces
+// apply to it. Either way the body's material is not used but in the time step (its wave speed
+// counts: give the soil's stiffness, not steel's).
 #include <algorithm>
 
 #include "framework/load_time.hpp"
 #include "framework/registry.hpp"
+#include "framework/rigid_motion.hpp"
 #include "framework/simulation.hpp"
 
 namespace loam {
 
 template <int D>
-class RigidBody : public Boundary<D> {
+class RigidBody : public Boundary<D>, public RigidMotion<D> {
  public:
   static constexpr const char* name = "rigid_body";
   static constexpr const char* summary =
@@ -35,24 +45,44 @@ class RigidBody : public Boundary<D> {
     Schema s;
     add_reaction_name(s);
     s.text("body", "the body that moves rigidly (its particles)").required();
-    s.vector("velocity", "m/s", "the body's velocity (components in `directions`)").required();
+    s.choice("motion", {"prescribed", "free"},
+             "prescribed: the body moves at `velocity` in `directions`; free (a body under "
+             "contact only): it follows the forces on it but in `directions`. Under contact "
+             "the body moves as one piece in every component either way (docs/contact.md); "
+             "two rigid bodies pass through each other")
+        .def("prescribed");
+    s.vector("velocity", "m/s",
+             "the body's velocity (components in `directions`); required unless the motion is "
+             "free in every component");
     s.string_list("directions",
-                  "components imposed on the nodes (x, y, z); default all (bonded contact)");
+                  "components prescribed (x, y, z); default all for a prescribed motion (bonded "
+                  "contact when the body is not under contact), none for a free one");
+    s.choice("rotation", {"free", "fixed"},
+             "a body under contact: whether it rotates with the moments on it or keeps its "
+             "orientation")
+        .def("free");
     s.plugin("time_function", "time_function",
              "factor f(t) on the velocity over the loads' time (absent: 1)");
     add_phase_param(s);
     return s;
   }
   explicit RigidBody(const Params& p)
-      : params_(p), body_name_(p.text("body")), phases_(parse_phase_mask(p)), f_(p) {
-    for (int d = 0; d < D; ++d) v_[size_t(d)] = p.vec("velocity")[size_t(d)];
+      : params_(p),
+        body_name_(p.text("body")),
+        phases_(parse_phase_mask(p)),
+        f_(p),
+        free_(p.text("motion") == "free"),
+        fixed_rotation_(p.text("rotation") == "fixed") {
+    if (p.has("velocity"))
+      for (int d = 0; d < D; ++d) v_[size_t(d)] = p.vec("velocity")[size_t(d)];
   }
   bool applies_to(int phase) const override { return (phases_ >> phase) & 1; }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     check_phase_mask(phases_, sim.scheme->phases(), params_, diag);
     if (!params_.has("directions")) {
-      for (int d = 0; d < D; ++d) dirs_.push_back(d);
+      if (!free_)
+        for (int d = 0; d < D; ++d) dirs_.push_back(d);
     } else {
       for (const auto& name : params_.strings("directions")) {
         const auto at = std::string("xyz").find(name);
@@ -68,28 +98,75 @@ class RigidBody : public Boundary<D> {
       return sim.unknown_body(diag, params_.where("body"), params_.path("body"), body_name_);
     set_ = sim.body_set(body_);
     sim_ = &sim;
+    check_motion(sim, diag);
     stencil_.allocate(sim.shape->max_nodes_per_particle());
     touched_.assign(sim.grid.num_nodes, 0);
   }
 
   /// The nodes the body's particles touch this step (their stencils' nodes with a weight).
-  void add_forces(const GridForces&) const override { refresh(); }
+  void add_forces(const GridForces&) const override {
+    if (!in_contact_) refresh();
+  }
 
   void constrain_grid_update(const GridUpdate& u) const override {
+    if (in_contact_) return;
     refresh();
     impose_velocity<D>(u, nodes_, dirs_, now_, [&](int k) { return applies_to(k); });
   }
   /// The MUSL re-mapped velocities, and USF's velocities before the grid update (the first
   /// call of a step finds the step's nodes).
   void constrain(const NodalVector& v) const override {
+    if (in_contact_) return;
     refresh();
     set_components<D>(v, nodes_, dirs_, now_);
   }
-  void mark_held(HeldComponents& held) const override { hold_components(held, nodes_, dirs_); }
+  void mark_held(HeldComponents& held) const override {
+    if (!in_contact_) hold_components(held, nodes_, dirs_);
+  }
+  /// Under contact: no nodes (the contact fields report the force on the body).
   const std::vector<size_t>* reaction_nodes() const override { return &nodes_; }
   bool reaction_nodes_move() const override { return true; }
 
+  const RigidMotion<D>* rigid_motion() const override { return in_contact_ ? this : nullptr; }
+  int rigid_body() const override { return body_; }
+  unsigned prescribed(double t, typename RigidDofs<D>::Vector& value) const override {
+    value.setZero();
+    unsigned mask = 0;
+    const double f = f_.value(t);
+    for (int d : dirs_) {
+      mask |= 1u << d;
+      value(d) = v_[size_t(d)] * f;
+    }
+    if (fixed_rotation_)
+      for (int k = D; k < RigidDofs<D>::Q; ++k) mask |= 1u << k;
+    return mask;
+  }
+
  private:
+  /// Under contact (its body listed, or every body) the body moves on its own field; a free
+  /// motion needs that, a velocity needs prescribed components, and these need a velocity.
+  void check_motion(const Simulation<D>& sim, Diagnostics& diag) {
+    if (sim.contact) {
+      const auto& listed = sim.contact->bodies();
+      in_contact_ =
+          listed.empty() || std::find(listed.begin(), listed.end(), body_name_) != listed.end();
+    }
+    if (free_ && !in_contact_)
+      diag.error(params_.where("motion"), params_.path("motion"),
+                 "a free rigid body moves on its own velocity field: list '" + body_name_ +
+                     "' under contact.bodies (or give contact: without bodies)");
+    if (!dirs_.empty() && !params_.has("velocity"))
+      diag.error(params_.where(), params_.path("velocity"),
+                 "the prescribed components need a velocity");
+    if (dirs_.empty() && params_.has("velocity"))
+      diag.error(params_.where("velocity"), params_.path("velocity"),
+                 "a velocity for a free motion: name the components it prescribes in "
+                 "`directions`");
+    if (params_.given("rotation") && !in_contact_)
+      diag.error(params_.where("rotation"), params_.path("rotation"),
+                 "rotation applies to a body under contact (this one is bonded to the grid "
+                 "and only translates)");
+  }
   /// The step's nodes and velocity, once per step (whichever call of the step comes first).
   void refresh() const {
     if (refreshed_ == sim_->step) return;
@@ -127,6 +204,8 @@ class RigidBody : public Boundary<D> {
   TimeFactor<D> f_;
   std::array<double, D> v_{};
   std::vector<int> dirs_;
+  bool free_, fixed_rotation_;
+  bool in_contact_ = false;  // moves on its own field (framework/contact_fields.hpp)
   int body_ = -1, set_ = 0;
   const Simulation<D>* sim_ = nullptr;
   mutable StencilBlock<D> stencil_;

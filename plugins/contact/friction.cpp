@@ -34,7 +34,8 @@ class FrictionContact : public Contact<D> {
 
   void exchange(double ma, double mb, double (&va)[D], double (&vb)[D], const double (&n)[D],
                 Approach approach) const override {
-    const double share = mb / (ma + mb);  // v_a - v_cm = m_b / (m_a + m_b) (v_a - v_b)
+    // v_a - v_cm = m_b / (m_a + m_b) (v_a - v_b); a rigid b (m_b infinite): v_cm = v_b.
+    const double share = std::isinf(mb) ? 1.0 : mb / (ma + mb);
     double rel[D], dn = 0;
     for (int d = 0; d < D; ++d) {
       rel[d] = share * (va[d] - vb[d]);
