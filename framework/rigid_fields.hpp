@@ -214,8 +214,11 @@ class RigidFields {
     }
     return Dofs::solve(r.metric, sum);
   }
-  /// r's rows: the components the conditions hold at its nodes with mass above the tolerance
-  /// (at the centre's velocity there), then its prescribed components.
+  /// r's rows: its prescribed components, then the components the conditions hold at its
+  /// nodes with mass above the tolerance (at the centre's velocity there) in its other
+  /// components only. A prescribed component thus takes the whole force along it (a footing
+  /// pushed down beside a held wall: the wall takes none of the vertical load); the faces
+  /// share the rest.
   void collect_rows(const Simulation<D>& sim, Body& r, const double* rec, const double* centre) {
     const HeldComponents& held = sim.held(0);
     std::vector<typename Dofs::Vector> rows;
@@ -228,16 +231,21 @@ class RigidFields {
       r.row_node.push_back(node);
       r.row_component.push_back(component);
     };
-    for (size_t n : r.nodes) {
-      if (!(rec[n * S + kMass] > sim.mass_tolerance)) continue;
-      for (int d = 0; d < D; ++d)
-        if (held.held(n, d))
-          add(map_at(r, n).row(d).transpose(), centre[n * S + kMomentum + size_t(d)], n, d);
-    }
     typename Dofs::Vector prescribed;
     const unsigned mask = r.motion->prescribed(sim.time - sim.loads_start, prescribed);
     for (int k = 0; k < Dofs::Q; ++k)
       if ((mask >> k) & 1) add(Dofs::Vector::Unit(k), prescribed(k), kPrescribed, k);
+    for (size_t n : r.nodes) {
+      if (!(rec[n * S + kMass] > sim.mass_tolerance)) continue;
+      for (int d = 0; d < D; ++d) {
+        if (!held.held(n, d)) continue;
+        typename Dofs::Vector row = map_at(r, n).row(d).transpose();
+        double value = centre[n * S + kMomentum + size_t(d)];
+        for (int k = 0; k < Dofs::Q; ++k)
+          if ((mask >> k) & 1) value -= row(k) * prescribed(k), row(k) = 0;
+        if (row.squaredNorm() > 0) add(row, value, n, d);
+      }
+    }
     r.rows.resize(long(rows.size()), Dofs::Q);
     r.values.resize(long(rows.size()));
     for (size_t i = 0; i < rows.size(); ++i) {

@@ -305,3 +305,37 @@ TEST_CASE("rigid body in contact: bad input is located", "[contact][rigid][cli]"
       dir.path, with("{type: rigid_body, body: block, velocity: [0, 0], rotation: fixed}", false),
       "run.yaml:", "rotation applies to a body under contact");
 }
+
+TEST_CASE(
+    "rigid body in contact: the granular barrier scene's wall stays put and takes the "
+    "impact",
+    "[contact][rigid]") {
+  // configs/granular_barrier_2d.yaml to 0.5 s: the wall's particles do not move (1e-12 m), it
+  // takes no force before the front reaches it (the front is at 0.37 m at 0.24 s, the wall at
+  // 0.5 m: |F| < 1e-9 N/m to 0.25 s) and pushes back after (mean over 0.34-0.5 s > 0). The
+  // force against the hydrodynamic estimate rho v^2 h is printed (docs/contact.md, the
+  // barrier scene: the mean over 0.34-0.42 s is 1-2 times it).
+  loam_test::TempDir dir("rigid_barrier");
+  const auto r = loam_test::run_loam(
+      "run " + (fs::path(LOAM_SOURCE_DIR) / "configs" / "granular_barrier_2d.yaml").string() +
+      " --quiet --threads 2 --set time.end=0.5 --out " + (dir.path / "out").string());
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  const auto h = loam_test::read_csv_columns(dir.path / "out" / "history.csv");
+  double before = 0;
+  for (size_t i = 0; i < h.at("time").size(); ++i)
+    if (h.at("time")[i] <= 0.25)
+      before = std::max(before, std::fabs(h.at("reaction_barrier_x")[i]));
+  const double impact = -mean_over(h, "reaction_barrier_x", 0.34, 0.42);
+  const double after = -mean_over(h, "reaction_barrier_x", 0.34, 0.5);
+  const int sand = 20 * 40 * 4;  // 0.2 x 0.4 m of 0.01 m cells, 2 x 2 points each
+  const Spread u = body_field(dir.path / "out" / "particles_000025.h5", "displacement", sand);
+  std::printf(
+      "granular barrier: |F| before the front %.1e N/m, mean force 0.34-0.42 s %.1f N/m, "
+      "0.34-0.5 s %.1f N/m; wall moved %.1e m\n",
+      before, impact, after,
+      std::max({std::fabs(u.mean[0]), std::fabs(u.mean[1]), u.spread[0], u.spread[1]}));
+  CHECK(before < 1e-9);
+  CHECK(after > 0);
+  CHECK(std::max({std::fabs(u.mean[0]), std::fabs(u.mean[1]), u.spread[0], u.spread[1]}) < 1e-12);
+}
