@@ -331,11 +331,16 @@ class ContactFields {
   /// The exchange at node n, then the held components set to the centre's v_c again.
   void exchange_at(size_t n, const HeldComponents& held, const double* c, const double* m,
                    double (*v)[D]) {
-    exchange_pairs(n, m, v, Approach::kJudged, held, rigid_.impulses());
+    double* impulse = rigid_.impulses();
+    exchange_pairs(n, m, v, Approach::kJudged, held, impulse);
     for (int d = 0; d < D; ++d)
       if (held.held(n, d))
-        for (int f = 0; f < fields_; ++f)
-          if (!rigid_.field_is_rigid(f)) v[f][d] = c[kMomentum + d];
+        for (int f = 0; f < fields_; ++f) {
+          if (!rigid_.field_is_rigid(f))
+            v[f][d] = c[kMomentum + d];
+          else if (impulse)  // the other fields do not keep what the exchange gave them here
+            impulse[(size_t(f) * nodes_ + n) * D + size_t(d)] = 0;
+        }
   }
   /// Both fields move with their centre of mass (mb infinite: with b).
   static void bond(double ma, double mb, double (&va)[D], double (&vb)[D]) {

@@ -49,7 +49,7 @@ class RigidFields {
     for (const auto& b : sim.boundaries) {
       const RigidMotion<D>* motion = b->rigid_motion();
       if (!motion) continue;
-      Body r;
+      Rigid r;
       r.condition = b.get();
       r.motion = motion;
       r.field = field_of_body_[size_t(motion->rigid_body())];
@@ -60,6 +60,7 @@ class RigidFields {
     if (bodies_.empty()) return;
     if (impulse_.empty()) impulse_.assign(size_t(fields_) * nodes_ * D, 0.0);
     measure(sim);
+    drop_empty_bodies();
   }
 
   bool any() const { return !bodies_.empty(); }
@@ -74,15 +75,13 @@ class RigidFields {
 
   /// u(x_I) at node n of rigid field f, with the body's current motion.
   void velocity(int f, size_t n, double (&u)[D]) const {
-    const Body& r = bodies_[size_t(of_field_[size_t(f)])];
-    const Eigen::Matrix<double, D, 1> v = map_at(r, n) * r.q;
-    for (int d = 0; d < D; ++d) u[d] = v(d);
+    velocity(bodies_[size_t(of_field_[size_t(f)])], n, u);
   }
 
   /// Step 1 (the header) from the fields' records (S per node, nodes per field) and the centre
   /// record's held velocities.
   void predict(const Simulation<D>& sim, const double* records, const double* centre, double dt) {
-    for (Body& r : bodies_) {
+    for (Rigid& r : bodies_) {
       const double* rec = records + size_t(r.field) * nodes_ * S;
       r.start = momentum_motion(r, rec);
       typename Dofs::Vector force = Dofs::Vector::Zero();
@@ -98,7 +97,7 @@ class RigidFields {
 
   /// Step 3 (the header) on the fields' records.
   void correct(Simulation<D>& sim, double* records, double dt) {
-    for (Body& r : bodies_) {
+    for (Rigid& r : bodies_) {
       typename Dofs::Vector impulse = Dofs::Vector::Zero();
       const double* imp = impulse_.data() + size_t(r.field) * nodes_ * D;
       for (size_t n : r.nodes) impulse += map_at(r, n).transpose() * Column(imp + n * D);
@@ -123,12 +122,12 @@ class RigidFields {
   /// the step's motion, or (`at_start`, USF before the update) the motion its momenta in
   /// `records` carry.
   void set_velocities(const double* records, double* velocities, bool at_start) {
-    for (Body& r : bodies_) {
+    for (Rigid& r : bodies_) {
       if (at_start) r.q = momentum_motion(r, records + size_t(r.field) * nodes_ * S);
       double* vel = velocities + size_t(r.field) * nodes_ * D;
       for (size_t n : r.nodes) {
         double u[D];
-        velocity(r.field, n, u);
+        velocity(r, n, u);
         std::copy(u, u + D, vel + n * D);
       }
     }
@@ -137,14 +136,14 @@ class RigidFields {
  private:
   using Dofs = RigidDofs<D>;
   using Column = Eigen::Map<const Eigen::Matrix<double, D, 1>>;
-  static constexpr size_t kPrescribed = ~size_t(0);  // Body::row_node of a prescribed row
+  static constexpr size_t kPrescribed = ~size_t(0);  // Rigid::row_node of a prescribed row
 
   /// A body that moves rigidly in this step: its condition, field, mass, centre of mass and
   /// metric diag(M, J) (its particles at x^n), its nodes (mass > 0), the rows that constrain it
   /// (the velocities they impose, each one's node or kPrescribed and component, their impulse
   /// shares), its motion at t^n, after its own forces (`free`), and the motion it meets the
   /// other fields with, then the step's (`q`).
-  struct Body {
+  struct Rigid {
     const Boundary<D>* condition = nullptr;
     const RigidMotion<D>* motion = nullptr;
     int field = 0;
@@ -163,7 +162,7 @@ class RigidFields {
   int fields_ = 0;
   size_t nodes_ = 0;
   std::vector<int> field_of_body_;
-  std::vector<Body> bodies_;
+  std::vector<Rigid> bodies_;
   std::vector<int> of_field_;        // per field: its entry in bodies_, or -1
   std::vector<uint8_t> rigid_body_;  // per body: moves rigidly in this step
   std::vector<double> impulse_;      // fields * nodes * D
@@ -171,18 +170,28 @@ class RigidFields {
   /// Mass, centre of mass and metric sum_p m_p G^T G (M on V; J = sum m (|r|^2 I - r r^T) on
   /// omega) of each body from its particles.
   void measure(const Simulation<D>& sim) {
-    for_each_particle(sim, [](Body& r, double m, const double(&x)[D]) {
+    for_each_particle(sim, [](Rigid& r, double m, const double(&x)[D]) {
       r.mass += m;
       for (int d = 0; d < D; ++d) r.centre[d] += m * x[d];
     });
-    for (Body& r : bodies_)
-      for (int d = 0; d < D; ++d) r.centre[d] /= r.mass;
-    for_each_particle(sim, [](Body& r, double m, const double(&x)[D]) {
+    for (Rigid& r : bodies_)
+      for (int d = 0; d < D; ++d) r.centre[d] = r.mass > 0 ? r.centre[d] / r.mass : 0.0;
+    for_each_particle(sim, [](Rigid& r, double m, const double(&x)[D]) {
       double rel[D];
       for (int d = 0; d < D; ++d) rel[d] = x[d] - r.centre[d];
       const auto g = Dofs::velocity_map(rel);
       r.metric += m * g.transpose() * g;
     });
+  }
+  /// A body whose particles have all left (a sink) moves no more: it is dropped.
+  void drop_empty_bodies() {
+    for (size_t k = bodies_.size(); k-- > 0;)
+      if (!(bodies_[k].mass > 0)) {
+        of_field_[size_t(bodies_[k].field)] = -1;
+        rigid_body_[size_t(bodies_[k].motion->rigid_body())] = 0;
+        bodies_.erase(bodies_.begin() + long(k));
+      }
+    for (size_t k = 0; k < bodies_.size(); ++k) of_field_[size_t(bodies_[k].field)] = int(k);
   }
   template <class F>
   void for_each_particle(const Simulation<D>& sim, F&& f) {
@@ -197,14 +206,18 @@ class RigidFields {
       }
     }
   }
+  void velocity(const Rigid& r, size_t n, double (&u)[D]) const {
+    const Eigen::Matrix<double, D, 1> v = map_at(r, n) * r.q;
+    for (int d = 0; d < D; ++d) u[d] = v(d);
+  }
   /// G(x_I - x_c) at node n of body r.
-  typename Dofs::Map map_at(const Body& r, size_t n) const {
+  typename Dofs::Map map_at(const Rigid& r, size_t n) const {
     double rel[D];
     for (int d = 0; d < D; ++d) rel[d] = grid_->node_coord(n, d) - r.centre[d];
     return Dofs::velocity_map(rel);
   }
   /// The motion r's nodal momenta carry (M_q q = sum G^T p); its nodes (mass > 0) found anew.
-  typename Dofs::Vector momentum_motion(Body& r, const double* rec) const {
+  typename Dofs::Vector momentum_motion(Rigid& r, const double* rec) const {
     typename Dofs::Vector sum = Dofs::Vector::Zero();
     r.nodes.clear();
     for (size_t n = 0; n < nodes_; ++n) {
@@ -215,11 +228,13 @@ class RigidFields {
     return Dofs::solve(r.metric, sum);
   }
   /// r's rows: its prescribed components, then the components the conditions hold at its
-  /// nodes with mass above the tolerance (at the centre's velocity there) in its other
-  /// components only. A prescribed component thus takes the whole force along it (a footing
-  /// pushed down beside a held wall: the wall takes none of the vertical load); the faces
-  /// share the rest.
-  void collect_rows(const Simulation<D>& sim, Body& r, const double* rec, const double* centre) {
+  /// nodes with mass above the tolerance (at the centre's velocity there) that are not
+  /// prescribed, in its free components only. A prescribed component thus takes the whole
+  /// force along it (a footing pushed down beside a held wall: the wall takes none of the
+  /// vertical load; a sled pushed along a fixed base: the base holds it up, not back); where
+  /// a symmetry plane should also keep a prescribed body from turning, give it
+  /// `rotation: fixed`.
+  void collect_rows(const Simulation<D>& sim, Rigid& r, const double* rec, const double* centre) {
     const HeldComponents& held = sim.held(0);
     std::vector<typename Dofs::Vector> rows;
     std::vector<double> values;
@@ -239,6 +254,7 @@ class RigidFields {
       if (!(rec[n * S + kMass] > sim.mass_tolerance)) continue;
       for (int d = 0; d < D; ++d) {
         if (!held.held(n, d)) continue;
+        if ((mask >> d) & 1) continue;  // the prescribed velocity wins along d
         typename Dofs::Vector row = map_at(r, n).row(d).transpose();
         double value = centre[n * S + kMomentum + size_t(d)];
         for (int k = 0; k < Dofs::Q; ++k)
@@ -256,27 +272,27 @@ class RigidFields {
   /// The rows' impulses x_i (per row, along it) as forces x_i / dt: at a held node, in its
   /// component, to the condition credited with the node; the prescribed translation
   /// components' to r's condition.
-  static void report_row_forces(Simulation<D>& sim, const Body& r, const Eigen::VectorXd& impulse,
-                                double dt) {
+  void report_row_forces(Simulation<D>& sim, const Rigid& r, const Eigen::VectorXd& impulse,
+                         double dt) const {
     double prescribed[D] = {};
     for (long i = 0; i < impulse.size(); ++i) {
       const size_t n = r.row_node[size_t(i)];
       const int k = r.row_component[size_t(i)];
       if (n == kPrescribed) {
         if (k < D) prescribed[k] += impulse(i) / dt;
-      } else {
-        double f[D] = {};
-        f[k] = impulse(i) / dt;
-        sim.reactions.add_node_force(n, f);
+        continue;
       }
+      double f[D] = {};
+      f[k] = impulse(i) / dt;
+      sim.reactions.add_node_force(n, f);
     }
     sim.reactions.add_force(r.condition, prescribed);
   }
   /// r's nodes get u(x_I) in the momentum slot and (u - p / m) / dt in the force slot.
-  void write_nodes(const Body& r, double* rec, double dt) const {
+  void write_nodes(const Rigid& r, double* rec, double dt) const {
     for (size_t n : r.nodes) {
       double u[D];
-      velocity(r.field, n, u);
+      velocity(r, n, u);
       double* x = rec + n * S;
       for (int d = 0; d < D; ++d) {
         x[kForce + d] = (u[d] - x[kMomentum + d] / x[kMass]) / dt;

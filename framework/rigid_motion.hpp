@@ -47,11 +47,12 @@ struct RigidDofs {
       return M.ldlt().solve(b);
   }
 
-  /// The q nearest q_free in the metric M with rows q = values (least squares where they
-  /// conflict; rows that repeat each other count once): the component of q_free in the rows'
-  /// null space, weighted by M, plus the minimum-norm solution of the rows. `impulse` gets each
-  /// row's share x_i of the impulse M (q - q_free) = sum_i x_i row_i (the minimum-norm shares,
-  /// so that redundant rows, the nodes of one flat face, carry it evenly).
+  /// The q nearest q_free in the metric M with rows q = values (Gauss's principle of least
+  /// constraint: the constrained motion departs least, in kinetic energy, from the free one;
+  /// least squares where the rows conflict; rows that repeat each other count once): the component
+  /// of q_free in the rows' null space, weighted by M, plus the minimum-norm solution of the rows.
+  /// `impulse` gets each row's share x_i of the impulse M (q - q_free) = sum_i x_i row_i (the
+  /// minimum-norm shares, so that redundant rows, the nodes of one flat face, carry it evenly).
   static Vector constrained(const Vector& q_free, const Matrix& M, const Eigen::MatrixXd& rows,
                             const Eigen::VectorXd& values, Eigen::VectorXd& impulse) {
     impulse.setZero(rows.rows());

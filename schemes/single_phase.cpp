@@ -504,9 +504,12 @@ class SinglePhase : public Scheme<D> {
         }
       }
       double v2 = 0, vp[D];
+      // A rigid body's particles take PIC; the ledger counts its energy as the body's.
+      const double share = nodes.flip(flip, b + size_t(p));
       for (int d = 0; d < D; ++d) {
-        vp[d] = flip_pic(nodes.flip(flip, b + size_t(p)), v[size_t(d)][p], dt, a[d], vn[d]);
-        if (flip < 1) loss += m[p] * transfer_loss(v[size_t(d)][p], dt, a[d], vp[d]);
+        vp[d] = flip_pic(share, v[size_t(d)][p], dt, a[d], vn[d]);
+        if (share < 1 && share == flip)
+          loss += m[p] * transfer_loss(v[size_t(d)][p], dt, a[d], vp[d]);
         v[size_t(d)][p] = vp[d];
         v2 += vp[d] * vp[d];
         if constexpr (MOVE) x[size_t(d)][p] = walls.moved(d, x[size_t(d)][p], dt * vn[d]);
@@ -640,11 +643,13 @@ class SinglePhase : public Scheme<D> {
         for (int d = 0; d < D; ++d) x[size_t(d)][p] = walls.moved(d, x[size_t(d)][p], dt * vn[d]);
       if (kFromRecord && !apic) {
         double v2 = 0;
+        const double share = nodes.flip(flip, b + size_t(p));  // PIC for a rigid body's
         for (int d = 0; d < D; ++d) {
           double& vp = v[size_t(d)][p];
           const double v_old = vp;
-          vp = flip_pic(nodes.flip(flip, b + size_t(p)), vp, dt, a[d], vn[d]);
-          if (flip < 1) loss += P.col(P.mass)[b + size_t(p)] * transfer_loss(v_old, dt, a[d], vp);
+          vp = flip_pic(share, vp, dt, a[d], vn[d]);
+          if (share < 1 && share == flip)
+            loss += P.col(P.mass)[b + size_t(p)] * transfer_loss(v_old, dt, a[d], vp);
           v2 += vp * vp;
         }
         max_v2 = std::max(max_v2, v2);

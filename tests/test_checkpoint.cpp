@@ -116,6 +116,16 @@ TEST_CASE("a resumed contact run is bitwise the uninterrupted one, 1 and 2 threa
                "--set time.end=0.3 --set output.energy_balance=true", 1000, 2000);
 }
 
+TEST_CASE("a resumed run with a rigid body under contact is bitwise the uninterrupted one",
+          "[checkpoint][contact][rigid]") {
+  // configs/granular_barrier_2d.yaml to 0.4 s with the energy balance, resumed from step 6000
+  // (0.33 s, as the front reaches the wall): the rigid body's mass, centre, inertia and motion
+  // are rebuilt from its particles every step, so the checkpoint needs nothing of them.
+  check_resume("granular_barrier_2d.yaml",
+               "--set time.end=0.4 --set output.energy_balance=true --set output.every_time=0.1",
+               2000, 6000);
+}
+
 TEST_CASE("a resumed two-phase run is bitwise the uninterrupted one, 1 and 2 threads",
           "[checkpoint]") {
   // configs/seed001_terzaghi.yaml (two_phase_single_point, terzaghi reference) to t = 0.05 s

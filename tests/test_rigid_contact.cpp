@@ -115,6 +115,89 @@ TEST_CASE(
   }
 }
 
+TEST_CASE("rigid body in contact: in 3D a free block falls onto a fixed base and rests on it",
+          "[contact][rigid]") {
+  // Reference: W = 0.2^3 * 2000 * 9.81 = 156.96 N at rest on the base (0.5 %, mean over the last
+  // 0.1 s); the block moves as one piece.
+  const std::string scene = R"(
+grid: {origin: [0, 0, 0], extent: [0.6, 0.6, 0.6], cell_size: 0.05}
+shape_function: gimp
+scheme: {type: single_phase, update: musl}
+gravity: [0, -9.81, 0]
+bodies:
+  - name: block
+    generator: {type: box, min: [0.2, 0.25, 0.2], max: [0.4, 0.45, 0.4]}
+    material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2000}
+boundaries:
+  - {type: fixed, face: y-, name: base}
+  - {type: rigid_body, body: block, motion: free}
+contact: {type: friction, coefficient: 0.3}
+time: {end: 0.6}
+output: {every_time: 0.6, fields: [velocity], history_every: 1}
+)";
+  loam_test::TempDir dir("rigid_fall_3d");
+  const auto r = loam_test::run_yaml(dir.path, scene, "--threads 2");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  const auto h = loam_test::read_csv_columns(dir.path / "out" / "history.csv");
+  const double weight = 0.008 * 2000 * 9.81;
+  const double base = mean_over(h, "reaction_base_y", 0.5, 0.6);
+  const Spread v = body_field(dir.path / "out" / "particles_000001.h5", "velocity", 0);
+  std::printf(
+      "rigid block in 3D on a fixed base: base reaction %.4f N (weight %.4f), |v| %.1e, "
+      "spread of v %.1e\n",
+      base, weight, std::hypot(v.mean[0], v.mean[1]), std::max(v.spread[0], v.spread[1]));
+  CHECK(std::fabs(base / weight - 1) < 0.005);
+  CHECK(std::max(v.spread[0], v.spread[1]) < 1e-9);
+}
+
+TEST_CASE(
+    "rigid body in contact: a sled pushed along a fixed base with free rotation neither "
+    "spins nor is held back",
+    "[contact][rigid]") {
+  // The base holds x and y at its nodes; the sled's x is prescribed (0.5 m/s), y and its
+  // rotation free. The prescribed component wins along x (the base adds no row there) and the
+  // base's y rows hold it up and keep it from turning: no spin (the particles' velocities all
+  // 0.5, 0 to 1e-9), the pusher needs no force along x once moving (|F_x| < 1e-9 W over
+  // 0.2-0.5 s), and the base carries the weight (0.5 %).
+  const std::string scene = R"(
+grid: {origin: [0, 0], extent: [1.5, 0.5], cell_size: 0.05}
+shape_function: gimp
+scheme: {type: single_phase, update: musl}
+gravity: [0, -9.81]
+bodies:
+  - name: sled
+    generator: {type: box, min: [0.2, 0.0], max: [0.4, 0.1]}
+    material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2000}
+boundaries:
+  - {type: fixed, face: y-, name: base}
+  - {type: rigid_body, body: sled, motion: free, directions: [x], velocity: [0.5, 0],
+     name: sled}
+contact: {type: friction, coefficient: 0.3}
+time: {end: 0.5}
+output: {every_time: 0.5, fields: [velocity], history_every: 1}
+)";
+  loam_test::TempDir dir("rigid_sled");
+  const auto r = loam_test::run_yaml(dir.path, scene, "--threads 2");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  const auto h = loam_test::read_csv_columns(dir.path / "out" / "history.csv");
+  const double weight = 0.02 * 2000 * 9.81;
+  double pusher = 0;
+  for (size_t i = 0; i < h.at("time").size(); ++i)
+    if (h.at("time")[i] > 0.2) pusher = std::max(pusher, std::fabs(h.at("reaction_sled_x")[i]));
+  const double base = mean_over(h, "reaction_base_y", 0.2, 0.5);
+  const Spread v = body_field(dir.path / "out" / "particles_000001.h5", "velocity", 0);
+  std::printf(
+      "sled along a fixed base: v %.6f, %.1e (spread %.1e), largest |F_x| of the pusher "
+      "%.1e N, base %.3f N (weight %.3f)\n",
+      v.mean[0], v.mean[1], std::max(v.spread[0], v.spread[1]), pusher, base, weight);
+  CHECK(std::fabs(v.mean[0] - 0.5) < 1e-9);
+  CHECK(std::max(v.spread[0], v.spread[1]) < 1e-9);
+  CHECK(pusher < 1e-9 * weight);
+  CHECK(std::fabs(base / weight - 1) < 0.005);
+}
+
 TEST_CASE("rigid body in contact: a block dragged over an elastic slab carries F_t = mu F_n",
           "[contact][rigid]") {
   // Reference: Coulomb sliding, F_t / F_n = mu = 0.3 (tolerance 1 %). The block's x velocity is
@@ -304,6 +387,10 @@ TEST_CASE("rigid body in contact: bad input is located", "[contact][rigid][cli]"
   loam_test::check_located_error(
       dir.path, with("{type: rigid_body, body: block, velocity: [0, 0], rotation: fixed}", false),
       "run.yaml:", "rotation applies to a body under contact");
+  loam_test::check_located_error(
+      dir.path,
+      with(free_body + "\n  - {type: rigid_body, body: block, velocity: [0, 0], name: again}"),
+      "run.yaml:", "another rigid_body of this list moves 'block'");
 }
 
 TEST_CASE(

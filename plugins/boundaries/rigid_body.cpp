@@ -49,7 +49,8 @@ class RigidBody : public Boundary<D>, public RigidMotion<D> {
              "prescribed: the body moves at `velocity` in `directions`; free (a body under "
              "contact only): it follows the forces on it but in `directions`. Under contact "
              "the body moves as one piece in every component either way (docs/contact.md); "
-             "two rigid bodies pass through each other")
+             "the faces that hold it are fixed and slip faces (not friction faces or "
+             "prescribed_velocity boxes); two rigid bodies pass through each other")
         .def("prescribed");
     s.vector("velocity", "m/s",
              "the body's velocity (components in `directions`); required unless the motion is "
@@ -151,6 +152,16 @@ class RigidBody : public Boundary<D>, public RigidMotion<D> {
       in_contact_ =
           listed.empty() || std::find(listed.begin(), listed.end(), body_name_) != listed.end();
     }
+    // Two in one list (a stage's list is set up beside the run's, which it replaces):
+    // the one set up later sees the earlier.
+    bool listed = false;
+    for (const auto& b : sim.boundaries) listed = listed || b.get() == this;
+    for (const auto& other : sim.boundaries)
+      if (listed && in_contact_ && other.get() != this && other->rigid_motion() &&
+          other->rigid_motion()->rigid_body() == body_)
+        diag.error(params_.where("body"), params_.path("body"),
+                   "another rigid_body of this list moves '" + body_name_ +
+                       "': give one condition per body");
     if (free_ && !in_contact_)
       diag.error(params_.where("motion"), params_.path("motion"),
                  "a free rigid body moves on its own velocity field: list '" + body_name_ +
