@@ -255,6 +255,7 @@ class ContactFields {
   std::vector<uint8_t> touching_;  // per node: the last update's exchange changed a velocity
   std::vector<double> vel_;        // fields * nodes * D: re-mapped momenta, then velocities
   RigidFields<D> rigid_;           // the fields of rigid bodies
+  static_assert(RigidFields<D>::S == S && RigidFields<D>::kForce == kForce);
 
   static constexpr int kMaxFields = 8;
   /// A field with less volume at a node than this share of a cell's takes no part in contact
@@ -312,9 +313,10 @@ class ContactFields {
         const bool rigid_a = rigid_.field_is_rigid(a), rigid_b = rigid_.field_is_rigid(b);
         if (rigid_a && rigid_b) continue;
         const int s = rigid_a ? b : a, t = rigid_a ? a : b;  // t: the rigid one, if either is
-        const double ms = m[s], mt = rigid_a || rigid_b ? kRigid : m[t];
+        const bool rigid = rigid_a || rigid_b;
+        const double ms = m[s], mt = rigid ? kRigid : m[t];
         double before[D] = {};
-        std::copy(v[s], v[s] + D, before);
+        if (impulse && rigid) std::copy(v[s], v[s] + D, before);
         double n[D];
         if (!touches_[size_t(a)] || !touches_[size_t(b)]) {
           bond(ms, mt, v[s], v[t]);
@@ -323,7 +325,7 @@ class ContactFields {
             for (int d = 0; d < D; ++d) n[d] = -n[d];  // from s towards t
           law_->exchange(ms, mt, v[s], v[t], n, approach);
         }
-        if (impulse && (rigid_a || rigid_b))
+        if (impulse && rigid)
           for (int d = 0; d < D; ++d)
             impulse[(size_t(t) * nodes_ + node) * D + size_t(d)] -= ms * (v[s][d] - before[d]);
       }

@@ -93,9 +93,7 @@ class Reactions {
   /// applies beyond the nodal mass it measured (a rigid body held there,
   /// framework/contact_fields.hpp); none if no reporting condition holds n.
   void add_node_force(size_t n, const double (&force)[D]) {
-    if (n >= owner_.size() || owner_[n] < 0) return;
-    double* r = step_.data() + size_t(owner_[n]) * kValues;
-    for (int d = 0; d < D; ++d) r[d] += force[d];
+    if (n < owner_.size() && owner_[n] >= 0) add_to_slot(owner_[n], force);
   }
 
   /// Face forces (Boundary::add_forces, e.g. an absorbing face's free-field reaction): the
@@ -125,9 +123,7 @@ class Reactions {
   /// prescribed motion and the faces it touches apply to it), phase 0.
   void add_force(const Boundary<D>* b, const double (&force)[D]) {
     const auto it = entries_.find(b);
-    if (it == entries_.end()) return;
-    double* r = step_.data() + size_t(it->second.slot) * kValues;
-    for (int d = 0; d < D; ++d) r[d] += force[d];
+    if (it != entries_.end()) add_to_slot(it->second.slot, force);
   }
 
   /// Local damping acts on the nodal forces of phase 0 (the only phase or the skeleton): the
@@ -188,6 +184,11 @@ class Reactions {
   }
 
  private:
+  /// Column `slot`'s phase-0 force of this step += force.
+  void add_to_slot(int slot, const double (&force)[D]) {
+    double* r = step_.data() + size_t(slot) * kValues;
+    for (int d = 0; d < D; ++d) r[d] += force[d];
+  }
   struct Entry {
     int slot = -1;
     std::vector<size_t> nodes;  // the condition's nodes this rank owns

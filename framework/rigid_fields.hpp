@@ -91,7 +91,7 @@ class RigidFields {
       }
       collect_rows(sim, r, rec, centre);
       r.free = r.start + dt * Dofs::solve(r.metric, force);
-      r.q = Dofs::constrained(r.free, r.metric, r.rows, r.values, r.impulse);
+      r.q = r.rows.constrained(r.free, r.metric, r.impulse);
     }
   }
 
@@ -103,7 +103,7 @@ class RigidFields {
       for (size_t n : r.nodes) impulse += map_at(r, n).transpose() * Column(imp + n * D);
       const typename Dofs::Vector met = r.q + Dofs::solve(r.metric, impulse);
       Eigen::VectorXd again;
-      const typename Dofs::Vector q = Dofs::constrained(met, r.metric, r.rows, r.values, again);
+      const typename Dofs::Vector q = r.rows.constrained(met, r.metric, again);
       report_row_forces(sim, r, r.impulse + again, dt);
       if (sim.ledger.enabled && !r.nodes.empty()) {
         const typename Dofs::Vector before = r.metric * (r.q - r.free);  // the rows' impulses
@@ -151,8 +151,8 @@ class RigidFields {
     double centre[D] = {};
     typename Dofs::Matrix metric = Dofs::Matrix::Zero();
     std::vector<size_t> nodes;
-    Eigen::MatrixXd rows;
-    Eigen::VectorXd values, impulse;
+    RigidRows<D> rows;
+    Eigen::VectorXd impulse;
     std::vector<size_t> row_node;
     std::vector<int> row_component;
     typename Dofs::Vector start = Dofs::Vector::Zero(), free = start, q = start;
@@ -262,12 +262,13 @@ class RigidFields {
         if (row.squaredNorm() > 0) add(row, value, n, d);
       }
     }
-    r.rows.resize(long(rows.size()), Dofs::Q);
-    r.values.resize(long(rows.size()));
+    Eigen::MatrixXd a(long(rows.size()), Dofs::Q);
+    Eigen::VectorXd b(long(rows.size()));
     for (size_t i = 0; i < rows.size(); ++i) {
-      r.rows.row(long(i)) = rows[i].transpose();
-      r.values(long(i)) = values[i];
+      a.row(long(i)) = rows[i].transpose();
+      b(long(i)) = values[i];
     }
+    r.rows.set(a, b);
   }
   /// The rows' impulses x_i (per row, along it) as forces x_i / dt: at a held node, in its
   /// component, to the condition credited with the node; the prescribed translation

@@ -46,31 +46,56 @@ struct RigidDofs {
     else
       return M.ldlt().solve(b);
   }
+};
 
-  /// The q nearest q_free in the metric M with rows q = values (Gauss's principle of least
-  /// constraint: the constrained motion departs least, in kinetic energy, from the free one;
-  /// least squares where the rows conflict; rows that repeat each other count once): the component
-  /// of q_free in the rows' null space, weighted by M, plus the minimum-norm solution of the rows.
-  /// `impulse` gets each row's share x_i of the impulse M (q - q_free) = sum_i x_i row_i (the
-  /// minimum-norm shares, so that redundant rows, the nodes of one flat face, carry it evenly).
-  static Vector constrained(const Vector& q_free, const Matrix& M, const Eigen::MatrixXd& rows,
-                            const Eigen::VectorXd& values, Eigen::VectorXd& impulse) {
-    impulse.setZero(rows.rows());
-    if (rows.rows() == 0) return q_free;
+/// Rows a_i q = b_i on q (a rigid body's constraints in a step, framework/rigid_fields.hpp),
+/// decomposed once for every projection of the step.
+template <int D>
+class RigidRows {
+ public:
+  using Dofs = RigidDofs<D>;
+  using Vector = typename Dofs::Vector;
+  using Matrix = typename Dofs::Matrix;
+
+  void set(const Eigen::MatrixXd& rows, const Eigen::VectorXd& values) {
+    count_ = rows.rows();
+    if (count_ == 0) return;
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(rows, Eigen::ComputeThinU | Eigen::ComputeFullV);
     svd.setThreshold(1e-10);
-    const int rank = int(svd.rank());
-    Vector q = svd.solve(values);
-    if (rank < Q) {
-      const Eigen::MatrixXd null = svd.matrixV().rightCols(Q - rank);
+    rank_ = int(svd.rank());
+    particular_ = svd.solve(values);
+    u_ = svd.matrixU().leftCols(rank_);
+    v_ = svd.matrixV();
+    sigma_ = svd.singularValues().head(rank_);
+  }
+
+  /// The q nearest q_free in the metric M that meets the rows (Gauss's principle of least
+  /// constraint: the constrained motion departs least, in kinetic energy, from the free one;
+  /// least squares where the rows conflict; rows that repeat each other count once): the
+  /// component of q_free in the rows' null space, weighted by M, plus the minimum-norm solution
+  /// of the rows. `impulse` gets each row's share x_i of the impulse M (q - q_free) = sum_i x_i
+  /// row_i (the minimum-norm shares, so that redundant rows, the nodes of one flat face, carry
+  /// it evenly).
+  Vector constrained(const Vector& q_free, const Matrix& M, Eigen::VectorXd& impulse) const {
+    impulse.setZero(count_);
+    if (count_ == 0) return q_free;
+    Vector q = particular_;
+    if (rank_ < Dofs::Q) {
+      const Eigen::MatrixXd null = v_.rightCols(Dofs::Q - rank_);
       const Eigen::MatrixXd metric = null.transpose() * M * null;
       q += null * metric.ldlt().solve(null.transpose() * M * (q_free - q));
     }
-    const Eigen::VectorXd along =
-        svd.matrixV().leftCols(rank).transpose() * (M * (q - q_free)).eval();
-    impulse = svd.matrixU().leftCols(rank) * along.cwiseQuotient(svd.singularValues().head(rank));
+    const Eigen::VectorXd along = v_.leftCols(rank_).transpose() * (M * (q - q_free)).eval();
+    impulse = u_ * along.cwiseQuotient(sigma_);
     return q;
   }
+
+ private:
+  long count_ = 0;
+  int rank_ = 0;
+  Vector particular_ = Vector::Zero();  // the rows' minimum-norm solution
+  Eigen::MatrixXd u_, v_;               // the rows' U (rank columns) and V (all)
+  Eigen::VectorXd sigma_;               // their singular values above the threshold
 };
 
 /// What a condition that makes a body rigid tells the contact fields.

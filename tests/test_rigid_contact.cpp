@@ -64,6 +64,15 @@ Spread body_field(const fs::path& frame, const std::string& field, int first, in
   return s;
 }
 
+/// `yaml` run in dir/out on 2 threads (it must succeed); its history.csv columns.
+std::map<std::string, std::vector<double>> run_history(const fs::path& dir,
+                                                       const std::string& yaml) {
+  const auto r = loam_test::run_yaml(dir, yaml, "--threads 2");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  return loam_test::read_csv_columns(dir / "out" / "history.csv");
+}
+
 /// Mean of history column `name` over lines with time in (from, to].
 double mean_over(const std::map<std::string, std::vector<double>>& h, const std::string& name,
                  double from, double to) {
@@ -92,10 +101,7 @@ TEST_CASE(
                                                         {"cpdi", "musl"},
                                                         {"gimp", "usf"}}) {
     loam_test::TempDir dir("rigid_fall_" + shape + "_" + update);
-    const auto r = loam_test::run_yaml(dir.path, falling_block(shape, update), "--threads 2");
-    INFO(r.output);
-    REQUIRE(r.exit_code == 0);
-    const auto h = loam_test::read_csv_columns(dir.path / "out" / "history.csv");
+    const auto h = run_history(dir.path, falling_block(shape, update));
     const double base = mean_over(h, "reaction_base_y", 0.6, 0.8);
     const double own = mean_over(h, "reaction_block_y", 0.6, 0.8);
     const Spread v = body_field(dir.path / "out" / "particles_000008.h5", "velocity", 0);
@@ -136,10 +142,7 @@ time: {end: 0.6}
 output: {every_time: 0.6, fields: [velocity], history_every: 1}
 )";
   loam_test::TempDir dir("rigid_fall_3d");
-  const auto r = loam_test::run_yaml(dir.path, scene, "--threads 2");
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  const auto h = loam_test::read_csv_columns(dir.path / "out" / "history.csv");
+  const auto h = run_history(dir.path, scene);
   const double weight = 0.008 * 2000 * 9.81;
   const double base = mean_over(h, "reaction_base_y", 0.5, 0.6);
   const Spread v = body_field(dir.path / "out" / "particles_000001.h5", "velocity", 0);
@@ -178,10 +181,7 @@ time: {end: 0.5}
 output: {every_time: 0.5, fields: [velocity], history_every: 1}
 )";
   loam_test::TempDir dir("rigid_sled");
-  const auto r = loam_test::run_yaml(dir.path, scene, "--threads 2");
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  const auto h = loam_test::read_csv_columns(dir.path / "out" / "history.csv");
+  const auto h = run_history(dir.path, scene);
   const double weight = 0.02 * 2000 * 9.81;
   double pusher = 0;
   for (size_t i = 0; i < h.at("time").size(); ++i)
@@ -230,12 +230,8 @@ output: {every_time: 0.2, fields: [velocity, displacement], history_every: 1,
   const double mass = 0.2 * 0.2 * 2000;
   for (const char* shape : {"linear", "bspline2"}) {
     loam_test::TempDir dir(std::string("rigid_drag_") + shape);
-    const auto r = loam_test::run_yaml(
-        dir.path, "shape_function: " + std::string(shape) + "\n" + scene, "--threads 2");
-    INFO(r.output);
-    REQUIRE(r.exit_code == 0);
+    const auto h = run_history(dir.path, "shape_function: " + std::string(shape) + "\n" + scene);
     const fs::path out = dir.path / "out";
-    const auto h = loam_test::read_csv_columns(out / "history.csv");
     const double tangential = -mean_over(h, "reaction_block_x", 0.2, 1.0);  // pulls against it
     const Spread v1 = body_field(out / "particles_000001.h5", "velocity", slab);
     const Spread v5 = body_field(out / "particles_000005.h5", "velocity", slab);
@@ -289,11 +285,8 @@ time: {end: 0.4}
 output: {every_time: 0.1, fields: [velocity, displacement], history_every: 10}
 )";
   loam_test::TempDir dir("rigid_strike");
-  const auto r = loam_test::run_yaml(dir.path, scene, "--threads 2");
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
+  const auto h = run_history(dir.path, scene);
   const fs::path out = dir.path / "out";
-  const auto h = loam_test::read_csv_columns(out / "history.csv");
   const double p0 = 0.2 * 0.2 * 2000 * 1.0;
   double drift = 0;
   for (double p : h.at("momentum_x")) drift = std::max(drift, std::fabs(p - p0));
