@@ -91,7 +91,7 @@ class ContactFields {
                  "at most " + std::to_string(kMaxFields) +
                      " velocity fields: the bodies in contact and one for the others");
     if (!diag.ok()) return;
-    rigid_.setup(sim.grid, fields_, field_of_body_);
+    rigid_.setup(sim, fields_, field_of_body_);
     rec_.assign(size_t(fields_) * nodes_ * S, 0.0);
     volume_.assign(size_t(fields_) * nodes_ * G, 0.0);
     vel_.assign(size_t(fields_) * nodes_ * D, 0.0);
@@ -143,11 +143,32 @@ class ContactFields {
     sum_fields(vel_.data(), D, 0, D, centre, threads);
   }
 
+  /// The nodes where a rigid body's field and another field have mass (the rigid body holds
+  /// that field there; Simulation::apply_damping leaves them); none without rigid bodies.
+  const std::vector<size_t>& supported_nodes(const Simulation<D>& sim) {
+    supported_.clear();
+    if (!rigid_.any()) return supported_;
+    const double tol = sim.mass_tolerance;
+    for (size_t n = 0; n < nodes_; ++n) {
+      bool rigid = false, other = false;
+      for (int f = 0; f < fields_; ++f) {
+        const bool mass = rec_[(size_t(f) * nodes_ + n) * S + kMass] > tol;
+        (rigid_.field_is_rigid(f) ? rigid : other) |= mass;
+      }
+      if (rigid && other) supported_.push_back(n);
+    }
+    return supported_;
+  }
+
   /// The fields' updated velocities and accelerations from the centre's (updated and
   /// constrained: velocity in its momentum slot, acceleration in its force slot), the header's
   /// equations; the contact's work goes to the energy ledger.
   void update(Simulation<D>& sim, const double* centre, double dt) {
-    if (rigid_.any()) rigid_.predict(sim, rec_.data(), centre, dt);
+    if (rigid_.any()) {
+      rigid_.predict(sim, rec_.data(), centre, dt);
+      find_bonds(sim, centre, dt);
+      rigid_.couple(sim, rec_.data());
+    }
     const double tol = sim.mass_tolerance;
     const HeldComponents& held = sim.held(0);
     const int F = fields_;
@@ -160,23 +181,9 @@ class ContactFields {
       touching[n] = 0;
       const double* c = centre + n * S;
       double m[kMaxFields], v[kMaxFields][D], vn[kMaxFields][D];
-      int with_mass = 0;
-      for (int f = 0; f < F; ++f) {
-        const double* r = rec + size_t(f) * region + n * S;
-        m[f] = r[kMass] > tol ? r[kMass] : 0.0;
-        with_mass += m[f] > 0;
-        for (int d = 0; d < D; ++d) {
-          vn[f][d] = m[f] > 0 ? r[kMomentum + d] / m[f] : c[kMomentum + d];
-          v[f][d] = m[f] > 0 ? vn[f][d] + dt * r[kForce + d] / m[f] : c[kMomentum + d];
-        }
-        if (rigid[f] >= 0 && m[f] > 0) rigid_.velocity(f, n, v[f]);
-      }
+      const int with_mass = node_state(n, c, tol, dt, m, v, vn);
       if (with_mass > 1 && c[kMass] > tol) {
-        follow_centre(c, m, v, F, rigid);
-        for (int d = 0; d < D; ++d)
-          if (held.held(n, d))
-            for (int f = 0; f < F; ++f)
-              if (rigid[f] < 0) v[f][d] = c[kMomentum + d];
+        before_exchange(n, c, m, v, held);
         double before[kMaxFields][D];
         std::copy(&v[0][0], &v[0][0] + F * D, &before[0][0]);
         exchange_at(n, held, c, m, v);
@@ -254,6 +261,7 @@ class ContactFields {
   std::vector<double> volume_;     // fields * nodes * G: volume and volume gradient
   std::vector<uint8_t> touching_;  // per node: the last update's exchange changed a velocity
   std::vector<double> vel_;        // fields * nodes * D: re-mapped momenta, then velocities
+  std::vector<size_t> supported_;  // supported_nodes()
   RigidFields<D> rigid_;           // the fields of rigid bodies
   static_assert(RigidFields<D>::S == S && RigidFields<D>::kForce == kForce);
 
@@ -284,6 +292,50 @@ class ContactFields {
         sim.constrain(NodalVector{vel_.data() + size_t(f) * nodes_ * D, D, 0});
   }
 
+  /// At node n: each field's mass (0 below the tolerance), velocity at t^n (vn) and after its
+  /// own forces (v; a rigid field's from its body's motion), the centre's where it has no
+  /// mass; returns how many fields have mass.
+  int node_state(size_t n, const double* c, double tol, double dt, double* m, double (*v)[D],
+                 double (*vn)[D]) const {
+    int with_mass = 0;
+    const int* rigid = rigid_.of_field();
+    for (int f = 0; f < fields_; ++f) {
+      const double* r = rec_.data() + (size_t(f) * nodes_ + n) * S;
+      m[f] = r[kMass] > tol ? r[kMass] : 0.0;
+      with_mass += m[f] > 0;
+      for (int d = 0; d < D; ++d) {
+        vn[f][d] = m[f] > 0 ? r[kMomentum + d] / m[f] : c[kMomentum + d];
+        v[f][d] = m[f] > 0 ? vn[f][d] + dt * r[kForce + d] / m[f] : c[kMomentum + d];
+      }
+      if (rigid[f] >= 0 && m[f] > 0) rigid_.velocity(f, n, v[f]);
+    }
+    return with_mass;
+  }
+  /// The fields follow the centre's update, and the components a condition holds take its
+  /// velocity (the exchange starts from these).
+  void before_exchange(size_t n, const double* c, const double* m, double (*v)[D],
+                       const HeldComponents& held) const {
+    const int* rigid = rigid_.of_field();
+    follow_centre(c, m, v, fields_, rigid);
+    for (int d = 0; d < D; ++d)
+      if (held.held(n, d))
+        for (int f = 0; f < fields_; ++f)
+          if (rigid[f] < 0) v[f][d] = c[kMomentum + d];
+  }
+  /// The exchange the update will make where a rigid body meets another field, tried with the
+  /// bodies at their predicted motion: which fields it binds to them and how (RigidFields::
+  /// couple moves each body together with them).
+  void find_bonds(Simulation<D>& sim, const double* centre, double dt) {
+    const double tol = sim.mass_tolerance;
+    const HeldComponents& held = sim.held(0);
+    for (size_t n : supported_nodes(sim)) {
+      const double* c = centre + n * S;
+      double m[kMaxFields], v[kMaxFields][D], vn[kMaxFields][D];
+      if (node_state(n, c, tol, dt, m, v, vn) < 2 || !(c[kMass] > tol)) continue;
+      before_exchange(n, c, m, v, held);
+      exchange_pairs(n, m, v, Approach::kJudged, held, nullptr, rigid_.bonds());
+    }
+  }
   /// Shift the fields' velocities so that their centre of mass moves with the centre's updated
   /// velocity (the loads, face forces, damping and conditions the centre got).
   static void follow_centre(const double* c, const double* m, double (*v)[D], int F,
@@ -303,9 +355,10 @@ class ContactFields {
   /// Every two fields with mass exchange momentum: by the law where both are in contact (and a
   /// normal is found), else they move with their centre of mass. A rigid body's field enters
   /// as field b of infinite mass; the impulse the other field takes from it goes, reversed, to
-  /// `impulse` (fields * nodes * D) when given.
+  /// `impulse` (fields * nodes * D) when given, and how the exchange bound the field to it to
+  /// `bonds` (RigidFields::record_bond).
   void exchange_pairs(size_t node, const double* m, double (*v)[D], Approach approach,
-                      const HeldComponents& held, double* impulse) const {
+                      const HeldComponents& held, double* impulse, double* bonds = nullptr) const {
     constexpr double kRigid = std::numeric_limits<double>::infinity();
     for (int a = 0; a < fields_; ++a)
       for (int b = a + 1; b < fields_; ++b) {
@@ -316,11 +369,12 @@ class ContactFields {
         const bool rigid = rigid_a || rigid_b;
         const double ms = m[s], mt = rigid ? kRigid : m[t];
         double before[D] = {};
-        if (impulse && rigid) std::copy(v[s], v[s] + D, before);
+        if ((impulse || bonds) && rigid) std::copy(v[s], v[s] + D, before);
         double n[D];
+        bool normal = false;
         if (!touches_[size_t(a)] || !touches_[size_t(b)]) {
           bond(ms, mt, v[s], v[t]);
-        } else if (pair_normal(node, a, b, held, n)) {
+        } else if ((normal = pair_normal(node, a, b, held, n))) {
           if (rigid_a)
             for (int d = 0; d < D; ++d) n[d] = -n[d];  // from s towards t
           law_->exchange(ms, mt, v[s], v[t], n, approach);
@@ -328,13 +382,16 @@ class ContactFields {
         if (impulse && rigid)
           for (int d = 0; d < D; ++d)
             impulse[(size_t(t) * nodes_ + node) * D + size_t(d)] -= ms * (v[s][d] - before[d]);
+        if (bonds && rigid)
+          RigidFields<D>::record_bond(bonds, nodes_, s, t, node, before, v[s], v[t],
+                                      normal ? n : nullptr);
       }
   }
   /// The exchange at node n, then the held components set to the centre's v_c again.
   void exchange_at(size_t n, const HeldComponents& held, const double* c, const double* m,
                    double (*v)[D]) {
+    exchange_pairs(n, m, v, Approach::kJudged, held, rigid_.impulses());
     double* impulse = rigid_.impulses();
-    exchange_pairs(n, m, v, Approach::kJudged, held, impulse);
     for (int d = 0; d < D; ++d)
       if (held.held(n, d))
         for (int f = 0; f < fields_; ++f) {

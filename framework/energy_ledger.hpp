@@ -173,6 +173,11 @@ class EnergyLedger {
     if (enabled && (!distributed_ || owned_[n]))
       per_thread_[size_t(omp_get_thread_num())].contact += dissipated;
   }
+  /// Contact work not tied to a node (a rigid body's, summed over its nodes); under mpirun
+  /// one rank adds it.
+  void add_contact_total(double dissipated) {
+    if (enabled) per_thread_[size_t(omp_get_thread_num())].contact += dissipated;
+  }
   /// Work the conditions did in this step that no nodal force records (a rigid body's
   /// constraints, framework/contact_fields.hpp).
   void add_boundary_work(double work) {

@@ -106,9 +106,9 @@ class RigidMotion {
   virtual ~RigidMotion() = default;
   /// The body (index in Simulation::bodies) that moves rigidly.
   virtual int rigid_body() const = 0;
-  /// The components of q = (V, omega) prescribed at the loads' time t (bit k: component k) and
-  /// their values in `value`.
-  virtual unsigned prescribed(double t, typename Dofs::Vector& value) const = 0;
+  /// The components of q = (V, omega) prescribed over the step [t, t + dt] of the loads' time
+  /// (bit k: component k) and their values in `value`.
+  virtual unsigned prescribed(double t, double dt, typename Dofs::Vector& value) const = 0;
 };
 
 }  // namespace loam

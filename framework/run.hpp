@@ -194,6 +194,7 @@ class Run {
   // The loop and summary.json (runner.cpp).
   nlohmann::json base_summary() const;
   nlohmann::json reaction_summary() const;
+  nlohmann::json rigid_summary() const;
   std::vector<double> nearest_node(const Params& probe, Diagnostics& diag) const;
   /// The particle count of every set over all ranks (collective under mpirun).
   double global_particles() const {

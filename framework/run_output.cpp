@@ -266,6 +266,15 @@ void Run<D>::open_outputs(long resume_step) {
     for (int k = 0; k < sim_->scheme->phases(); ++k)
       for (int d = 0; d < D; ++d)
         history_.out() << ",reaction_" << name << (k ? "_water_" : "_") << "xyz"[d];
+  for (const auto& name : sim_->rigid_records.names()) {
+    const int R = RigidRecords<D>::R;
+    for (int d = 0; d < D; ++d)
+      history_.out() << ",rigid_" << name << "_displacement_"
+                     << "xyz"[d];
+    for (const char* what : {"_rotation", "_moment"})
+      for (int k = 0; k < R; ++k)
+        history_.out() << ",rigid_" << name << what << (R > 1 ? std::string("_") + "xyz"[k] : "");
+  }
   history_.out() << "\n";
   for (auto& pr : probes_) {
     pr.csv.open(dir_ / ("probe_" + pr.name + ".csv"));
@@ -388,6 +397,9 @@ void Run<D>::write_history() {
   for (size_t c = 0; c < r.names().size(); ++c)
     for (int k = 0; k < sim_->scheme->phases(); ++k)
       for (int d = 0; d < D; ++d) o << "," << r.force(c)[k * D + d];
+  const RigidRecords<D>& rigid = sim_->rigid_records;
+  for (size_t c = 0; c < rigid.names().size(); ++c)
+    for (int k = 0; k < D + 2 * RigidRecords<D>::R; ++k) o << "," << rigid.values(c)[k];
   o << "\n";
   history_.check();
 }

@@ -243,6 +243,8 @@ typename Run<D>::CheckpointImage Run<D>::checkpoint_image() {
     if (state.clear(), sim.boundaries[i]->save_state(state))
       image.plugins.emplace_back("plugin.boundary." + std::to_string(i), state);
   if (!sim.reactions.empty()) image.plugins.emplace_back("sim.reactions", sim.reactions.state());
+  if (!sim.rigid_records.empty())
+    image.plugins.emplace_back("sim.rigid_records", sim.rigid_records.state());
   if (sim.ledger.enabled) image.plugins.emplace_back("sim.energy_ledger", sim.ledger.state());
   return image;
 }
@@ -371,6 +373,7 @@ void Run<D>::restore_checkpoint() {
     if (probe.clear(), sim.boundaries[i]->save_state(probe))
       sim.boundaries[i]->restore_state(r.doubles("plugin.boundary." + std::to_string(i)));
   if (!sim.reactions.empty()) sim.reactions.restore(r.doubles("sim.reactions"));
+  if (!sim.rigid_records.empty()) sim.rigid_records.restore(r.doubles("sim.rigid_records"));
   if (sim.ledger.enabled) sim.ledger.restore(r.doubles("sim.energy_ledger"));
   // The checkpoints of the run so far, and none from beyond this one (that future is redone).
   for (const auto& file : checkpoint_files(dir_, sim.ranks->file_tag())) {
@@ -528,6 +531,7 @@ nlohmann::json Run<D>::base_summary() const {
   s["bytes_per_particle"] =
       particles > 0 ? size_t(bytes / particles) : sim_->sets[0].particles.bytes_per_particle();
   if (!sim_->reactions.empty()) s["reactions"] = reaction_summary();
+  if (!sim_->rigid_records.empty()) s["rigid_bodies"] = rigid_summary();
   return s;
 }
 
@@ -548,6 +552,26 @@ nlohmann::json Run<D>::reaction_summary() const {
       e[pre + "max"] = std::vector<double>(r.highest(c) + at, r.highest(c) + at + D);
     }
     out[r.names()[c]] = e;
+  }
+  return out;
+}
+
+/// Per rigid body under contact its displacement (m), rotation (rad) and moment (N m; per metre
+/// in 2D) after the last step, and the least and largest moment over the run
+/// (framework/rigid_records.hpp).
+template <int D>
+nlohmann::json Run<D>::rigid_summary() const {
+  using Records = RigidRecords<D>;
+  const Records& r = sim_->rigid_records;
+  nlohmann::json out = nlohmann::json::object();
+  for (size_t c = 0; c < r.names().size(); ++c) {
+    const double* v = r.values(c);
+    auto part = [&](int at, int n) { return std::vector<double>(v + at, v + at + n); };
+    out[r.names()[c]] = {{"displacement", part(Records::kDisplacement, D)},
+                         {"rotation", part(Records::kRotation, Records::R)},
+                         {"moment", part(Records::kMoment, Records::R)},
+                         {"moment_min", part(Records::kMomentLow, Records::R)},
+                         {"moment_max", part(Records::kMomentHigh, Records::R)}};
   }
   return out;
 }

@@ -37,11 +37,12 @@ void check_periodic_faces(const std::vector<std::unique_ptr<Boundary<D>>>& list,
 }
 
 /// Register each mechanical condition of a list under its reaction's name (`name`, else
-/// <type>_<face>, or <type>_<position> for a box); a name given twice in one list is a located
-/// error (its two forces would share a column).
+/// <type>_<face>, or <type>_<position> for a box), a rigid body under contact also in `rigid`;
+/// a name given twice in one list is a located error (its two forces would share a column).
 template <int D>
 void name_reactions(const std::vector<std::unique_ptr<Boundary<D>>>& list,
-                    const std::vector<Params>& params, Reactions<D>& reactions, Diagnostics& diag) {
+                    const std::vector<Params>& params, Reactions<D>& reactions,
+                    RigidRecords<D>& rigid, Diagnostics& diag) {
   std::vector<std::string> names;
   for (size_t i = 0; i < list.size() && i < params.size(); ++i) {
     if (!list[i]->reaction_nodes()) continue;
@@ -59,6 +60,7 @@ void name_reactions(const std::vector<std::unique_ptr<Boundary<D>>>& list,
     }
     names.push_back(name);
     reactions.add(list[i].get(), name);
+    if (list[i]->rigid_motion()) rigid.add(list[i].get(), name);
   }
 }
 
@@ -140,10 +142,11 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
   for (size_t k = 0; k < stages.size(); ++k)
     if (stages[k].sets_boundaries)
       check_periodic_faces(stages[k].boundaries, stages[k].params.list("boundaries"), diag);
-  name_reactions(boundaries, config.list("boundaries"), reactions, diag);
+  name_reactions(boundaries, config.list("boundaries"), reactions, rigid_records, diag);
   for (size_t k = 0; k < stages.size(); ++k)
     if (stages[k].sets_boundaries)
-      name_reactions(stages[k].boundaries, stages[k].params.list("boundaries"), reactions, diag);
+      name_reactions(stages[k].boundaries, stages[k].params.list("boundaries"), reactions,
+                     rigid_records, diag);
   held_faces = HeldFaces<D>(grid, boundaries);
   held_faces_water = HeldFaces<D>(grid, boundaries, 1);
   model_checked = true;
@@ -269,7 +272,6 @@ void Simulation<D>::split_over_ranks(Diagnostics& diag) {
   }
   if (reference && config.given("verify"))
     refuse_plugin(reference->runs_on_ranks(), config.section("verify"));
-  if (contact) refuse_plugin(false, config.section("contact"));
   if (!shape || !diag.ok()) return;
   // A periodic axis stays whole on every rank (its faces are joined node by node).
   std::array<bool, D> whole{};

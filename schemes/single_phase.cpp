@@ -427,7 +427,8 @@ class SinglePhase : public Scheme<D> {
     forces.momentum = node_vector(kMomentum);
     sim.apply_boundary_forces(forces);
     sim.apply_damping(NodeForces{node_.data(), node_vector(kMomentum), node_vector(kForce),
-                                 sim.grid.num_nodes, S});
+                                 sim.grid.num_nodes, S},
+                      FIELDS == Fields::kPerBody ? &contact_.supported_nodes(sim) : nullptr);
     const double tol = sim.mass_tolerance;
     double* g = node_.data();
     for_each_node(sim.grid.num_nodes, sim.threads, [=](size_t i) {

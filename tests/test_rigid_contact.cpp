@@ -118,6 +118,17 @@ TEST_CASE(
     CHECK(std::max(v.spread[0], v.spread[1]) < 1e-9);
     CHECK(std::max(u.spread[0], u.spread[1]) < 1e-9);
     CHECK(u.mean[1] < -0.2);  // it fell most of the 0.3 m (stops within a stencil of the base)
+    // history.csv's displacement of the centre of mass (framework/rigid_records.hpp) at the
+    // frame's time is the particles' mean displacement (equal masses), its rotation none.
+    const size_t at =
+        size_t(std::find(h.at("time").begin(), h.at("time").end(), 0.8) - h.at("time").begin());
+    REQUIRE(at < h.at("time").size());
+    const double record = h.at("rigid_block_displacement_y")[at];
+    std::printf("  its history: displacement %.9f m (particles %.9f), rotation %.1e rad\n", record,
+                u.mean[1], h.at("rigid_block_rotation")[at]);
+    CHECK(std::fabs(record - u.mean[1]) < 1e-9);
+    CHECK(std::fabs(h.at("rigid_block_displacement_x")[at] - u.mean[0]) < 1e-9);
+    CHECK(std::fabs(h.at("rigid_block_rotation")[at]) < 1e-9);
   }
 }
 
@@ -357,6 +368,16 @@ time: {end: 1.0}
   CHECK(std::fabs(spin / omega - 1) < 1e-3);
   CHECK(std::hypot(mean_v[0], mean_v[1]) < 1e-9);
   CHECK(growth < 1e-3);
+  // The record (framework/rigid_records.hpp): rotation omega t, no displacement, no moment.
+  using Records = loam::RigidRecords<2>;
+  const double* record = sim->rigid_records.values(0);
+  std::printf("  recorded rotation %.6f rad (omega t %.6f), displacement %.1e m, moment %.1e\n",
+              record[Records::kRotation], omega * t,
+              std::hypot(record[Records::kDisplacement], record[Records::kDisplacement + 1]),
+              record[Records::kMoment]);
+  CHECK(std::fabs(record[Records::kRotation] / (omega * t) - 1) < 1e-3);
+  CHECK(std::hypot(record[Records::kDisplacement], record[Records::kDisplacement + 1]) < 1e-9);
+  CHECK(record[Records::kMoment] == 0);
 }
 
 TEST_CASE("rigid body in contact: bad input is located", "[contact][rigid][cli]") {
@@ -384,6 +405,136 @@ TEST_CASE("rigid body in contact: bad input is located", "[contact][rigid][cli]"
       dir.path,
       with(free_body + "\n  - {type: rigid_body, body: block, velocity: [0, 0], name: again}"),
       "run.yaml:", "another rigid_body of this list moves 'block'");
+  loam_test::check_located_error(
+      dir.path, with("{type: rigid_body, body: block, velocity: [0, 1], displacement: [0, 1]}"),
+      "run.yaml:", "give a velocity or a displacement, not both");
+  loam_test::check_located_error(dir.path,
+                                 with("{type: rigid_body, body: block, displacement: [0, 1]}"),
+                                 "run.yaml:", "a displacement u f(t) needs the time_function f");
+}
+
+TEST_CASE(
+    "rigid body in contact: a plate that may not turn carries the weight and the moment of a "
+    "block resting off its centre",
+    "[contact][rigid]") {
+  // Statics: a rigid plate (0.6 x 0.1 m, held: velocity 0, rotation fixed) carries its own
+  // weight and the block's (0.2 x 0.2 m, 2000 kg/m^3, its centre e = 0.15 m right of the
+  // plate's): reaction_plate_y = W_plate + W_block = 1962 N/m, and the moment that keeps it from
+  // turning is W_block e = 117.72 N m/m. Means over 1.0-1.5 s without damping (the block
+  // rocks elastically), over 0.6-0.8 s with local damping 0.3 (which must not carry the load:
+  // the nodes a rigid body holds up are not damped). Tolerance 0.1 % and 0.5 %.
+  const double w_plate = 0.6 * 0.1 * 2000 * 9.81, w_block = 0.2 * 0.2 * 2000 * 9.81;
+  const double moment = w_block * 0.15;
+  for (const bool damped : {false, true}) {
+    loam_test::TempDir dir(damped ? "rigid_moment_damped" : "rigid_moment");
+    const auto h = run_history(dir.path, std::string(R"(
+grid: {origin: [0, 0], extent: [1.0, 1.0], cell_size: 0.05}
+shape_function: gimp
+scheme: {type: single_phase, update: musl}
+gravity: [0, -9.81]
+bodies:
+  - name: plate
+    generator: {type: box, min: [0.2, 0.2], max: [0.8, 0.3]}
+    material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2000}
+  - name: block
+    generator: {type: box, min: [0.55, 0.3], max: [0.75, 0.5]}
+    material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2000}
+boundaries:
+  - {type: rigid_body, body: plate, velocity: [0, 0], rotation: fixed, name: plate}
+contact: {type: friction, coefficient: 0.3}
+output: {every_time: 0.5, history_every: 1}
+)") + (damped ? "damping: {type: local, alpha: 0.3}\ntime: {end: 0.8}\n" : "time: {end: 1.5}\n"));
+    const double from = damped ? 0.6 : 1.0, to = damped ? 0.8 : 1.5;
+    const double fy = mean_over(h, "reaction_plate_y", from, to);
+    const double m = mean_over(h, "rigid_plate_moment", from, to);
+    std::printf(
+        "rigid plate under an eccentric block%s: reaction %.3f N/m (W %.3f, %+.2e), moment "
+        "%.4f N m/m (W e %.4f, %+.2e), rotation %.1e, displacement %.1e\n",
+        damped ? ", local damping 0.3" : "", fy, w_plate + w_block, fy / (w_plate + w_block) - 1, m,
+        moment, m / moment - 1, h.at("rigid_plate_rotation").back(),
+        std::hypot(h.at("rigid_plate_displacement_x").back(),
+                   h.at("rigid_plate_displacement_y").back()));
+    CHECK(std::fabs(fy / (w_plate + w_block) - 1) < 1e-3);
+    CHECK(std::fabs(m / moment - 1) < 5e-3);
+    CHECK(h.at("rigid_plate_rotation").back() == 0);
+  }
+}
+
+TEST_CASE("rigid body: a displacement table moves the body along it, bonded or under contact",
+          "[contact][rigid]") {
+  // rigid_body's displacement u f(t), f a table (0, 0), (0.2, 1), (0.3, 1), (0.5, 0.5): each
+  // step's velocity (f(t + dt) - f(t)) / dt u ends the step on the table, so at every step a
+  // footing particle (a probe) is displaced by u f(t) within 1e-12 m, bonded to the soil and as
+  // a rigid body under contact (there its recorded displacement too), and the footing stays
+  // rigid. Under contact with its rotation free it must not start to rock: the symmetric
+  // scene's rotation stays at round-off (1e-9 rad; moved alone against the soil it bears on,
+  // the footing's rotation grew from 1e-17 to 1e-3 rad within 0.03 s, by alternating sign).
+  auto f = [](double t) {
+    return t <= 0.2 ? t / 0.2 : t <= 0.3 ? 1.0 : 1.0 - 0.5 * (t - 0.3) / 0.2;
+  };
+  enum class Variant { kBonded, kContact, kFreeRotation };
+  for (const Variant variant : {Variant::kBonded, Variant::kContact, Variant::kFreeRotation}) {
+    const bool contact = variant != Variant::kBonded;
+    const bool turns = variant == Variant::kFreeRotation;
+    loam_test::TempDir dir(!contact ? "rigid_table"
+                           : turns  ? "rigid_table_turns"
+                                    : "rigid_table_contact");
+    std::string yaml = R"(
+grid: {origin: [0, 0], extent: [1.0, 1.0], cell_size: 0.05}
+gravity: [0, -9.81]
+bodies:
+  - name: soil
+    generator: {type: box, min: [0, 0], max: [1.0, 0.5]}
+    material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2000}
+  - name: footing
+    generator: {type: box, min: [0.4, 0.5], max: [0.6, 0.6]}
+    material: {type: linear_elastic, E: 1.0e7, nu: 0.3, density: 2000}
+boundaries:
+  - {type: fixed, face: y-}
+  - {type: slip, face: x-}
+  - {type: slip, face: x+}
+  - {type: rigid_body, body: footing, displacement: [0, -0.02], name: footing,
+     time_function: {type: table, times: [0, 0.2, 0.3, 0.5], values: [0, 1, 1, 0.5]}}
+time: {end: 0.5}
+output: {every_time: 0.25, fields: [displacement], history_every: 1}
+probes:
+  - {name: footing, particle_near: [0.5, 0.55], fields: [displacement], every_steps: 1}
+)";
+    if (contact) {
+      yaml += "contact: {type: friction, coefficient: 0.5}\n";
+      const std::string name = "name: footing,";
+      if (!turns) yaml.replace(yaml.find(name), name.size(), name + " rotation: fixed,");
+    }
+    const auto h = run_history(dir.path, yaml);
+    const auto probe = loam_test::read_csv_columns(dir.path / "out" / "probe_footing.csv");
+    double worst = 0, recorded = 0, rotation = 0;
+    for (size_t i = 0; i < probe.at("time").size(); ++i) {
+      const double t = probe.at("time")[i];
+      worst = std::max({worst, std::fabs(probe.at("displacement_y")[i] + 0.02 * f(t)),
+                        std::fabs(probe.at("displacement_x")[i])});
+    }
+    if (contact)
+      for (size_t i = 0; i < h.at("time").size(); ++i) {
+        recorded = std::max(recorded, std::fabs(h.at("rigid_footing_displacement_y")[i] +
+                                                0.02 * f(h.at("time")[i])));
+        rotation = std::max(rotation, std::fabs(h.at("rigid_footing_rotation")[i]));
+      }
+    const Spread u = body_field(dir.path / "out" / "particles_000002.h5", "displacement", 800);
+    std::printf(
+        "displacement table, %s: %zu steps, largest error of the footing %.1e m (recorded "
+        "%.1e m), spread %.1e m, at 0.5 s %.12f m (table -0.01), largest rotation %.1e rad\n",
+        !contact ? "bonded"
+        : turns  ? "under contact, rotation free"
+                 : "under contact",
+        probe.at("time").size(), worst, recorded, std::max(u.spread[0], u.spread[1]), u.mean[1],
+        rotation);
+    CHECK(probe.at("time").size() > 100);
+    CHECK(worst < 1e-12);
+    CHECK(recorded < 1e-12);
+    CHECK(std::max(u.spread[0], u.spread[1]) < 1e-12);
+    CHECK(std::fabs(u.mean[1] + 0.01) < 1e-12);
+    CHECK(rotation < 1e-9);
+  }
 }
 
 TEST_CASE(

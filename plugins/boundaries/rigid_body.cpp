@@ -1,5 +1,7 @@
 // A rigid body with a prescribed motion: the particles of a body (`body`) impose the body's
-// velocity v f(t) (f its time function of the loads' time, absent: 1) on every grid node they
+// velocity v f(t) (f its time function of the loads' time, absent: 1), or the velocity
+// u (f(t + dt) - f(t)) / dt that moves it by the displacement u f(t) (a table of f gives a
+// displacement history: each step ends on it), on every grid node they
 // touch, in the components `directions` (default: all, a rough contact bonded to the soil).
 // Every node of such a particle's stencil then moves at v, so the particle moves at v and its
 // velocity gradient sum_I v grad N_I is zero (partition of unity): the body translates without
@@ -14,7 +16,8 @@
 // soil, the body's weight under gravity and its inertia m dv/dt (zero at a constant velocity);
 // a probe on one of its particles (particle_near, fields [displacement]) gives its displacement.
 // Limits of this bonded form: translation only; no separation, no Coulomb sliding between the
-// body and the soil; serial runs only.
+// body and the soil. Under mpirun the nodes each rank finds are shared over the ranks, so every
+// copy of a node the body reaches is held.
 //
 // A body listed under `contact:` moves instead on its own velocity field as one piece
 // (framework/rigid_motion.hpp, framework/contact_fields.hpp): the contact law acts between it
@@ -53,8 +56,11 @@ class RigidBody : public Boundary<D>, public RigidMotion<D> {
              "prescribed_velocity boxes); two rigid bodies pass through each other")
         .def("prescribed");
     s.vector("velocity", "m/s",
-             "the body's velocity (components in `directions`); required unless the motion is "
-             "free in every component");
+             "the body's velocity v f(t) (components in `directions`); this or `displacement` "
+             "unless the motion is free in every component");
+    s.vector("displacement", "m",
+             "instead of a velocity: the body moves by the displacement u f(t) (components in "
+             "`directions`; give the time_function, e.g. a table of (time, factor) points)");
     s.string_list("directions",
                   "components prescribed (x, y, z); default all for a prescribed motion (bonded "
                   "contact when the body is not under contact), none for a free one");
@@ -63,7 +69,8 @@ class RigidBody : public Boundary<D>, public RigidMotion<D> {
              "orientation")
         .def("free");
     s.plugin("time_function", "time_function",
-             "factor f(t) on the velocity over the loads' time (absent: 1)");
+             "factor f(t) on the velocity, or on the displacement, over the loads' time (absent: "
+             "1)");
     add_phase_param(s);
     return s;
   }
@@ -73,11 +80,14 @@ class RigidBody : public Boundary<D>, public RigidMotion<D> {
         phases_(parse_phase_mask(p)),
         f_(p),
         free_(p.text("motion") == "free"),
-        fixed_rotation_(p.text("rotation") == "fixed") {
-    if (p.has("velocity"))
-      for (int d = 0; d < D; ++d) v_[size_t(d)] = p.vec("velocity")[size_t(d)];
+        fixed_rotation_(p.text("rotation") == "fixed"),
+        by_displacement_(p.has("displacement")) {
+    const char* key = by_displacement_ ? "displacement" : "velocity";
+    if (p.has(key))
+      for (int d = 0; d < D; ++d) v_[size_t(d)] = p.vec(key)[size_t(d)];
   }
   bool applies_to(int phase) const override { return (phases_ >> phase) & 1; }
+  bool runs_on_ranks() const override { return true; }
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     check_phase_mask(phases_, sim.scheme->phases(), params_, diag);
@@ -130,10 +140,10 @@ class RigidBody : public Boundary<D>, public RigidMotion<D> {
 
   const RigidMotion<D>* rigid_motion() const override { return in_contact_ ? this : nullptr; }
   int rigid_body() const override { return body_; }
-  unsigned prescribed(double t, typename RigidDofs<D>::Vector& value) const override {
+  unsigned prescribed(double t, double dt, typename RigidDofs<D>::Vector& value) const override {
     value.setZero();
     unsigned mask = 0;
-    const double f = f_.value(t);
+    const double f = factor(t, dt);
     for (int d : dirs_) {
       mask |= 1u << d;
       value(d) = v_[size_t(d)] * f;
@@ -166,13 +176,21 @@ class RigidBody : public Boundary<D>, public RigidMotion<D> {
       diag.error(params_.where("motion"), params_.path("motion"),
                  "a free rigid body moves on its own velocity field: list '" + body_name_ +
                      "' under contact.bodies (or give contact: without bodies)");
-    if (!dirs_.empty() && !params_.has("velocity"))
+    const char* key = by_displacement_ ? "displacement" : "velocity";
+    if (by_displacement_ && params_.has("velocity"))
+      diag.error(params_.where("displacement"), params_.path("displacement"),
+                 "give a velocity or a displacement, not both");
+    if (by_displacement_ && !f_.present())
+      diag.error(params_.where("displacement"), params_.path("displacement"),
+                 "a displacement u f(t) needs the time_function f (with f = 1 the body would not "
+                 "move)");
+    if (!dirs_.empty() && !params_.has(key))
       diag.error(params_.where(), params_.path("velocity"),
-                 "the prescribed components need a velocity");
-    if (dirs_.empty() && params_.has("velocity"))
-      diag.error(params_.where("velocity"), params_.path("velocity"),
-                 "a velocity for a free motion: name the components it prescribes in "
-                 "`directions`");
+                 "the prescribed components need a velocity (or a displacement)");
+    if (dirs_.empty() && params_.has(key))
+      diag.error(params_.where(key), params_.path(key),
+                 std::string("a ") + key +
+                     " for a free motion: name the components it prescribes in `directions`");
     if (params_.given("rotation") && !in_contact_)
       diag.error(params_.where("rotation"), params_.path("rotation"),
                  "rotation applies to a body under contact (this one is bonded to the grid "
@@ -182,9 +200,15 @@ class RigidBody : public Boundary<D>, public RigidMotion<D> {
   void refresh() const {
     if (refreshed_ == sim_->step) return;
     refreshed_ = sim_->step;
-    const double f = f_.value(sim_->time - sim_->loads_start);
+    const double f = factor(sim_->time - sim_->loads_start, sim_->dt);
     for (int d = 0; d < D; ++d) now_[size_t(d)] = v_[size_t(d)] * f;
     find_nodes();
+  }
+  /// The factor on v_ over the step [t, t + dt]: f(t) on a velocity, the displacement's rate
+  /// (f(t + dt) - f(t)) / dt.
+  double factor(double t, double dt) const {
+    if (!by_displacement_) return f_.value(t);
+    return dt > 0 ? (f_.value(t + dt) - f_.value(t)) / dt : 0.0;
   }
   /// Blocks of the body's set that hold a particle of the body are evaluated (the set is sorted
   /// by cell, so the body's particles fill few blocks); every node with a weight is kept once.
@@ -207,21 +231,35 @@ class RigidBody : public Boundary<D>, public RigidMotion<D> {
         }
       }
     }
+    if (sim_->ranks->distributed()) share_nodes();
+  }
+  /// Under mpirun a node the body reaches from another rank's block is held here too (the
+  /// flags completed over the ranks), so that every copy of a node is held alike.
+  void share_nodes() const {
+    flags_.assign(sim_->grid.num_nodes, 0.0);
+    for (size_t n : nodes_) flags_[n] = 1;
+    sim_->ranks->complete_nodes({{flags_.data(), 1, 1}});
+    for (size_t n : nodes_) touched_[n] = 0;
+    nodes_.clear();
+    for (size_t n = 0; n < flags_.size(); ++n)
+      if (flags_[n] > 0) touched_[n] = 1, nodes_.push_back(n);
   }
 
   Params params_;
   std::string body_name_;
   int phases_;
   TimeFactor<D> f_;
-  std::array<double, D> v_{};
+  std::array<double, D> v_{};  // the velocity v, or the displacement u
   std::vector<int> dirs_;
   bool free_, fixed_rotation_;
+  bool by_displacement_;     // v_ is a displacement u: the velocity is its rate
   bool in_contact_ = false;  // moves on its own field (framework/contact_fields.hpp)
   int body_ = -1, set_ = 0;
   const Simulation<D>* sim_ = nullptr;
   mutable StencilBlock<D> stencil_;
   mutable std::vector<uint8_t> touched_;
   mutable std::vector<size_t> nodes_;    // the nodes the body touches this step
+  mutable std::vector<double> flags_;    // under mpirun: per node, whether a rank's body reaches it
   mutable std::array<double, D> now_{};  // velocity of the current step
   mutable long refreshed_ = -2;          // the step whose nodes and velocity these are
 };
