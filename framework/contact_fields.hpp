@@ -145,6 +145,8 @@ class ContactFields {
 
   /// The nodes where a rigid body's field and another field have mass (the rigid body holds
   /// that field there; Simulation::apply_damping leaves them); none without rigid bodies.
+  /// Found once a step, after the scatter and before the update, which tries the exchange there
+  /// (find_bonds).
   const std::vector<size_t>& supported_nodes(const Simulation<D>& sim) {
     supported_.clear();
     if (!rigid_.any()) return supported_;
@@ -162,7 +164,8 @@ class ContactFields {
 
   /// The fields' updated velocities and accelerations from the centre's (updated and
   /// constrained: velocity in its momentum slot, acceleration in its force slot), the header's
-  /// equations; the contact's work goes to the energy ledger.
+  /// equations; the contact's work goes to the energy ledger. After this step's
+  /// supported_nodes().
   void update(Simulation<D>& sim, const double* centre, double dt) {
     if (rigid_.any()) {
       rigid_.predict(sim, rec_.data(), centre, dt);
@@ -324,11 +327,11 @@ class ContactFields {
   }
   /// The exchange the update will make where a rigid body meets another field, tried with the
   /// bodies at their predicted motion: which fields it binds to them and how (RigidFields::
-  /// couple moves each body together with them).
+  /// couple moves each body together with them), at this step's supported_nodes().
   void find_bonds(Simulation<D>& sim, const double* centre, double dt) {
     const double tol = sim.mass_tolerance;
     const HeldComponents& held = sim.held(0);
-    for (size_t n : supported_nodes(sim)) {
+    for (size_t n : supported_) {
       const double* c = centre + n * S;
       double m[kMaxFields], v[kMaxFields][D], vn[kMaxFields][D];
       if (node_state(n, c, tol, dt, m, v, vn) < 2 || !(c[kMass] > tol)) continue;
@@ -390,8 +393,8 @@ class ContactFields {
   /// The exchange at node n, then the held components set to the centre's v_c again.
   void exchange_at(size_t n, const HeldComponents& held, const double* c, const double* m,
                    double (*v)[D]) {
-    exchange_pairs(n, m, v, Approach::kJudged, held, rigid_.impulses());
     double* impulse = rigid_.impulses();
+    exchange_pairs(n, m, v, Approach::kJudged, held, impulse);
     for (int d = 0; d < D; ++d)
       if (held.held(n, d))
         for (int f = 0; f < fields_; ++f) {

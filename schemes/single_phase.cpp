@@ -426,9 +426,13 @@ class SinglePhase : public Scheme<D> {
     forces.mass = node_vector(kMass);
     forces.momentum = node_vector(kMomentum);
     sim.apply_boundary_forces(forces);
+    // Where a rigid body holds another up: left undamped, and the contact update tries the
+    // exchange there first.
+    const std::vector<size_t>* supported = nullptr;
+    if constexpr (FIELDS == Fields::kPerBody) supported = &contact_.supported_nodes(sim);
     sim.apply_damping(NodeForces{node_.data(), node_vector(kMomentum), node_vector(kForce),
                                  sim.grid.num_nodes, S},
-                      FIELDS == Fields::kPerBody ? &contact_.supported_nodes(sim) : nullptr);
+                      supported);
     const double tol = sim.mass_tolerance;
     double* g = node_.data();
     for_each_node(sim.grid.num_nodes, sim.threads, [=](size_t i) {
