@@ -28,7 +28,7 @@
 // Multilinear tents (shape functions whose stencil does not cover the particle's domain) are the
 // exception: there N_Ip D_p^-1 (x_I - x_p) = grad N_Ip (Jiang et al. 2015, section 5.3) does not
 // vanish with N_Ip, so a node a particle has just reached carries the affine term on a vanishing
-// mass and an acceleration f_I / m_I that grows as 1 / N_Ip. Measured 2026-12-04 on a bar
+// mass and an acceleration f_I / m_I that grows as 1 / N_Ip. Measured on a bar
 // translating across 0.1 m cells and a spinning disk (tests/test_apic.cpp): B_p D_p^-1 with D_p at
 // the new position, and C_p = sum_I v_I grad N_Ip^T from the updated grid, blew up at the bar's
 // free-end cell crossings (t = 0.25 s, 0.43 s); C_p = the velocity gradient of MUSL's plain
@@ -256,7 +256,7 @@ class AffineTransfer {
 
   /// The D x D columns (row-major) of the particle field holding B_p (or C_p), looked up once
   /// per block: looked up per particle through Particles::col, a chain of dependent loads held
-  /// up the P2G and G2P loops (issue 17's profile).
+  /// up the P2G and G2P loops (bench/RESULTS.md, the APIC profile).
   struct Columns {
     double* c[D * D] = {};
     LOAM_FORCE_INLINE void load(size_t i, double (&B)[D][D]) const {

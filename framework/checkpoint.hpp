@@ -1,5 +1,5 @@
 #pragma once
-// Checkpoint files (issue 14, "runs that survive"): one HDF5 file per checkpoint holding flat,
+// Checkpoint files (docs/architecture.md): one HDF5 file per checkpoint holding flat,
 // named arrays (doubles stored bit for bit, so a resumed run continues exactly: NaN and -0
 // included), written under a temporary name, flushed to disk (fsync) and renamed.
 // What a run stores in them and how it resumes: Run<D>::write_checkpoint / restore_checkpoint

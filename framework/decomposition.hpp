@@ -1,5 +1,5 @@
 #pragma once
-// Cartesian block decomposition of the grid over ranks (issue 18; docs/parallel.md): the ranks
+// Cartesian block decomposition of the grid over ranks (docs/parallel.md): the ranks
 // form a dims[0] x ... x dims[D-1] array (MPI_Dims_create / MPI_Cart_create), and rank `coords`
 // owns the cells [cell_lo, cell_hi) of its block, the particles in them (of every set) and the
 // nodes that are the lower corners of its cells (the last block along an axis also owns the

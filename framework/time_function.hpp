@@ -1,7 +1,7 @@
 #pragma once
 // Time-function plugin interface: a scalar factor f(t) of the time t (s) since the start of the
 // stage that set its owner (a load's time: Simulation::loads_start), e.g. a ramp, a pulse or a
-// table. A load multiplies its magnitude by it (issue 16: the blast's pressure pulse), a
+// table. A load multiplies its magnitude by it (the blast's pressure pulse), a
 // prescribed pore pressure its value, an inflow its velocity (and the distance its particles
 // travel, the integral).
 #include <algorithm>

@@ -5,7 +5,7 @@
 namespace loam {
 
 /// A schema starting with E (Pa), nu and density (kg/m^3). Soil models take nu in [0, 0.5)
-/// (issue 5: a negative Poisson's ratio is not a soil); general solids allow (-1, 0.5).
+/// (a negative Poisson's ratio is not a soil); general solids allow (-1, 0.5).
 inline Schema isotropic_elastic_schema(bool soil) {
   Schema s;
   s.real("E", "Pa", "Young's modulus").required().positive();

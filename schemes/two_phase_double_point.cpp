@@ -79,7 +79,7 @@
 // regains contact (sigma' restarting from 0) when that field is below n_max while it is
 // compressed (tr L_s < 0). No hysteresis. The nodal field counts the empty half cell beyond a
 // free surface of the soil (n_I = 0.7 there for n = 0.4), so grains settling at a free surface
-// inside the grid regain contact late or not at all: open (issue 13).
+// inside the grid regain contact late or not at all: a known limit.
 // Time step: the CFL limit of the materials, and of the fastest wave of the drag-free two-phase
 // equations at every solid point (fast_wave_speed2 with the liquid materials' stiffest K_w);
 // no drag limit: the implicit drag leaves the time step independent of the permeability

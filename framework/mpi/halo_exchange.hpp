@@ -1,6 +1,6 @@
 #pragma once
-// The halo exchange of nodal quantities between the blocks of a Cartesian decomposition (issue
-// 18; docs/parallel.md "Halo exchange"; framework/decomposition.hpp):
+// The halo exchange of nodal quantities between the blocks of a Cartesian decomposition
+// (docs/parallel.md "Halo exchange"; framework/decomposition.hpp):
 //   reverse: every rank sends the values its particles scattered onto ghost nodes to the
 //            neighbour that owns them, every nodal array of every phase packed in one buffer per
 //            neighbour; the owner adds what it receives in a fixed neighbour order (offsets in

@@ -1,5 +1,5 @@
 #pragma once
-// Particle migration between the blocks of a Cartesian decomposition (issue 18; docs/parallel.md):
+// Particle migration between the blocks of a Cartesian decomposition (docs/parallel.md):
 // after the move, every particle whose cell another rank owns goes to that rank with every
 // allocated field of the set's registry (the core's and every plugin's: stress, state
 // variables, affine moments, ...) and its id, material and body, bit for bit. One packed message

@@ -7,7 +7,7 @@
 // particle's own weights, i.e. at the particle centre, half a particle below the real surface.
 // Under large compression that misplaces the load: the top particle's cell then balances the
 // load with the wrong share of the cell, and the surface particle is over- or under-stressed
-// (1D soft column, issue 6: -25 kPa instead of -50 kPa with CPDI). apply_at: surface adds
+// (1D soft column: -25 kPa instead of -50 kPa with CPDI). apply_at: surface adds
 // t A_p N_I(x_s) to the nodal forces at the particle's surface point, the centre of its loaded
 // face convected with the deformation gradient F (requested for this), as CPDI convects its
 // domains: x_s = x_p + F (s/2) N, N the outward face normal in the reference configuration and
