@@ -84,16 +84,19 @@ std::string bench_scene(const std::string& scene, const std::string& shape,
     return saturate_with_liquid_points(yaml);
   }
   // The apic_ and tpic_ prefixes: any scene with that affine transfer added to its scheme, with
-  // the --update given (linear tents: usf only).
-  for (const std::string transfer : {"apic", "tpic"}) {
-    const std::string affine = transfer + "_";
-    if (scene.rfind(affine, 0) != 0) continue;
-    std::string yaml = bench_scene(scene.substr(affine.size()), shape, update);
+  // the --update given (linear tents: usf only); fbar_: with volumetric: fbar.
+  const std::pair<const char*, const char*> options[] = {{"apic_", ", transfer: apic"},
+                                                         {"tpic_", ", transfer: tpic"},
+                                                         {"fbar_", ", volumetric: fbar"}};
+  for (const auto& [option, setting] : options) {
+    const std::string prefix_of = option;
+    if (scene.rfind(prefix_of, 0) != 0) continue;
+    std::string yaml = bench_scene(scene.substr(prefix_of.size()), shape, update);
     const size_t line = yaml.find("scheme: {");
     const size_t end = line == std::string::npos ? line : yaml.find('\n', line);
     const size_t close = end == std::string::npos ? end : yaml.rfind('}', end);
     if (yaml.empty() || close == std::string::npos || close < line) return "";
-    yaml.insert(close, ", transfer: " + transfer);  // the scheme map's last brace
+    yaml.insert(close, setting);  // the scheme map's last brace
     return yaml;
   }
   const bool two_phase = scene.rfind("two_phase_", 0) == 0;
@@ -160,8 +163,9 @@ int run_scene(const BenchOptions& opt, const std::string& scene, const std::stri
       std::fprintf(stderr,
                    "loam: error: unknown bench scene '%s' (elastic_block_2d, elastic_block_3d, "
                    "two_phase_elastic_block_2d, two_phase_elastic_block_3d; prefix "
-                   "double_point_: the block saturated with liquid points; suffix _two_sets: "
-                   "the block split over two particle sets)\n",
+                   "double_point_: the block saturated with liquid points; prefixes apic_, "
+                   "tpic_: that transfer, fbar_: volumetric: fbar; suffix _two_sets: the block "
+                   "split over two particle sets)\n",
                    scene.c_str());
       return 2;
     }

@@ -104,6 +104,9 @@ class ContactFields {
   size_t offset(const uint16_t* body, size_t i, int width) const {
     return size_t(field_of_body_[body[i]]) * nodes_ * size_t(width);
   }
+  /// The velocity field of particle i's body, and how many fields there are.
+  int field(const uint16_t* body, size_t i) const { return field_of_body_[body[i]]; }
+  int num_fields() const { return fields_; }
   double* records() { return rec_.data(); }
   double* volumes() { return volume_.data(); }
   double* velocities() { return vel_.data(); }

@@ -93,8 +93,8 @@ int main(int argc, char** argv) {
                     "prefix: saturated with a liquid point beside every solid point, "
                     "two_phase_double_point scheme; apic_ and tpic_ prefixes: the scene with "
                     "transfer: apic or tpic (e.g. apic_two_phase_elastic_block_2d; linear tents "
-                    "need --update usf); "
-                    "_two_sets suffix: the block over two sets)");
+                    "need --update usf); fbar_ prefix: the single-phase scene with volumetric: "
+                    "fbar; _two_sets suffix: the block over two sets)");
   bench->add_option("--update", bench_opt.update, "musl, usl or usf");
   bench->add_option("--shape-functions", bench_opt.shapes,
                     "shape functions (default linear; all: every one)");

@@ -19,6 +19,7 @@
 
 #include "framework/affine_transfer.hpp"
 #include "framework/contact_fields.hpp"
+#include "framework/fbar.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 #include "framework/step_blocks.hpp"
@@ -38,6 +39,7 @@ class SinglePhase : public Scheme<D> {
              "grid update), usf (before forces)")
         .def("musl");
     add_transfer_params(s, "; with linear tents update: usf");
+    add_volumetric_param(s, "the particles' stress");
     s.string_list("sets",
                   "names of the particle sets; all are summed onto the one velocity field (e.g. "
                   "a column split into two sets behaves as one), each has its own output frames")
@@ -67,7 +69,8 @@ class SinglePhase : public Scheme<D> {
         flip_(p.real("flip")),
         transfer_(p.text("transfer")),
         affine_on_(AffineTransfer<D>::is_affine(transfer_)),
-        sets_(p.strings("sets")) {}
+        sets_(p.strings("sets")),
+        fbar_(volumetric_of(p)) {}
 
   /// The affine matrix is part of the particle velocity field (a velocity reset zeroes it).
   std::vector<std::string> velocity_fields() const override {
@@ -161,6 +164,7 @@ class SinglePhase : public Scheme<D> {
   std::vector<double> node_;  // num_nodes * S
   std::vector<double> vel_;   // num_nodes * D: velocity used for the velocity gradient
   ContactFields<D> contact_;  // the bodies' own velocity fields, with `contact:`
+  Fbar<D> fbar_;              // volumetric: fbar
   static_assert(ContactFields<D>::S == S && ContactFields<D>::kForce == kForce);
   static constexpr int G = ContactFields<D>::G;
   using Scratch = BlockScratch<D>;
@@ -291,6 +295,7 @@ class SinglePhase : public Scheme<D> {
   /// fields, with their volume and its gradient).
   template <int NPP, bool MOMENTUM, bool FORCE, Fields FIELDS>
   void scatter_all(Simulation<D>& sim) {
+    if (fbar_.on()) sim.timed("fbar", [&] { fbar_before_scatter<MOMENTUM, FORCE, FIELDS>(sim); });
     // APIC's P2G is its own instantiation per form: the FLIP loop stays as it is without it.
     // Contact takes FLIP only (setup).
     sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
@@ -331,8 +336,52 @@ class SinglePhase : public Scheme<D> {
   };
   template <int NPP, Gradient MODE, Fields FIELDS>
   void update_stresses(Simulation<D>& sim, double dt) {
+    if (fbar_.on()) fbar_.resize(sim);
     sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
       update_stress<NPP, MODE, FIELDS>(sim, s, dt, b, c, t);
+    });
+    if (fbar_.on()) sim.timed("fbar", [&] { update_stresses_fbar<FIELDS>(sim, dt); });
+  }
+  /// F-bar's groups of particles: one (the shared field), or each body's field with contact (a
+  /// rigid body's particles in none); f(groups, group), group(set, i).
+  template <Fields FIELDS, class F>
+  void with_fbar_groups(Simulation<D>& sim, F&& f) {
+    if constexpr (FIELDS == Fields::kShared) {
+      f(1, [](size_t, size_t) { return 0; });
+    } else {
+      f(contact_.num_fields(), [this, &sim](size_t set, size_t i) {
+        const uint16_t* body = sim.sets[set].particles.body.data();
+        return contact_.rigid(body, i) ? Fbar<D>::kNoGroup : contact_.field(body, i);
+      });
+    }
+  }
+  /// F-bar at a scatter: where the particles are (the step's first scatter), and the mean
+  /// stress projected for the internal force (framework/fbar.hpp).
+  template <bool MOMENTUM, bool FORCE, Fields FIELDS>
+  void fbar_before_scatter(Simulation<D>& sim) {
+    with_fbar_groups<FIELDS>(sim, [&](int groups, auto group) {
+      if (MOMENTUM) fbar_.locate(sim, groups, group);
+      if (FORCE) fbar_.project_mean_stress(sim, group);
+    });
+  }
+  /// F-bar (framework/fbar.hpp): the kept velocity gradients' volume ratios projected per
+  /// velocity field, then each particle's volume, F and stress from its L_bar.
+  template <Fields FIELDS>
+  void update_stresses_fbar(Simulation<D>& sim, double dt) {
+    with_fbar_groups<FIELDS>(sim,
+                             [&](int, auto group) { fbar_.project_volume_ratios(sim, group); });
+    sim.gather_blocks([&](ParticleSet<D>& set, size_t b, int count, int thread) {
+      Particles<D>& P = set.particles;
+      double* L = scratch_[size_t(thread)]->L.data();
+      double* V = P.col(P.volume) + b;
+      const auto F = deformation_gradient_block(P, F_, b);
+      for (int p = 0; p < count; ++p) {
+        double l[D][D];
+        fbar_.averaged_gradient(sim.set_slot(set), b + size_t(p), dt, l);
+        store_velocity_gradient<D>(l, L, p);
+        update_volume_and_deformation<D>(l, dt, V[p], F, p);
+      }
+      sim.update_block_stress(set, b, count, dt, L);
     });
   }
 
@@ -355,6 +404,8 @@ class SinglePhase : public Scheme<D> {
       fe[size_t(d)] = sim.external_force >= 0 ? P.col(sim.external_force, d) + b : nullptr;
     }
     for (int c = 0; c < NS; ++c) sig[size_t(c)] = P.col(P.stress, c) + b;
+    // F-bar: the projected mean stress in the force (Fbar::pressure_shifts).
+    const double* shift = FORCE && fbar_.on() ? fbar_.shifts(sim.set_slot(set)) + b : nullptr;
     const std::array<double, D> gravity = sim.gravity;
     typename AffineTransfer<D>::Stencil as;
     typename AffineTransfer<D>::template Momenta<NPP, FORM> am;  // APIC: momenta per weight
@@ -372,6 +423,8 @@ class SinglePhase : public Scheme<D> {
         body[d] = mp * gravity[size_t(d)] + (fe[size_t(d)] ? fe[size_t(d)][p] : 0.0);
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * sig[size_t(voigt_index(d, j))][p];
       }
+      if (shift)
+        for (int d = 0; d < D; ++d) sv[d][d] += V[p] * shift[p];
       if constexpr (AFFINE) {  // APIC: m_p (N v_p + B_p D_p^-1 N (x_I - x_p)), see the header
         double mC[D][D];       // m_p B_p D_p^-1
         affine_.stencil(P, st, p, b + size_t(p), npp, as);
@@ -619,6 +672,8 @@ class SinglePhase : public Scheme<D> {
     const double flip = flip_;
     const bool apic = affine_on_;  // USL with APIC: the velocities are updated already
     const HeldFaces<D> walls = sim.held_faces;
+    const bool fbar = fbar_.on();
+    const size_t slot = sim.set_slot(set);
     double max_v2 = sc.max_v2, loss = 0;
     // Linear tents with an affine transfer: the gradient is the particle's C_p.
     const bool store_C = MODE == Gradient::kCurrent && B_ >= 0 && affine_.needs_usf();
@@ -641,9 +696,13 @@ class SinglePhase : public Scheme<D> {
             for (int d = 0; d < D; ++d) a[d] += w * g[n * S + kForce + size_t(d)];
         }
       }
-      store_velocity_gradient<D>(l, L, p);
       if (store_C) C.store(b + size_t(p), l);
-      update_volume_and_deformation<D>(l, dt, V[p], F, p);
+      if (fbar) {
+        fbar_.keep(slot, b + size_t(p), l, dt);  // update_stresses_fbar
+      } else {
+        store_velocity_gradient<D>(l, L, p);
+        update_volume_and_deformation<D>(l, dt, V[p], F, p);
+      }
       if constexpr (kMove)
         for (int d = 0; d < D; ++d) x[size_t(d)][p] = walls.moved(d, x[size_t(d)][p], dt * vn[d]);
       if (kFromRecord && !apic) {
@@ -661,8 +720,8 @@ class SinglePhase : public Scheme<D> {
       }
     }
     sc.max_v2 = max_v2;
-    if (flip < 1) sim.ledger.add_transfer_loss(sim.set_slot(set), b, 0.5 * loss);
-    sim.update_block_stress(set, b, count, dt, L);
+    if (flip < 1) sim.ledger.add_transfer_loss(slot, b, 0.5 * loss);
+    if (!fbar) sim.update_block_stress(set, b, count, dt, L);
   }
 };
 

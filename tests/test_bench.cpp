@@ -58,3 +58,17 @@ TEST_CASE("loam bench's apic_ and tpic_ prefixes add the affine transfer", "[cli
     CHECK(r.output.find("with linear tents needs update: usf") != std::string::npos);
   }
 }
+
+TEST_CASE("loam bench's fbar_ prefix adds volumetric: fbar to the single-phase scheme",
+          "[cli][bench][locking]") {
+  auto r =
+      loam_test::run_loam("bench --scenes fbar_elastic_block_2d --threads 1 --steps 2 --repeat 1");
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 0);
+  CHECK(r.output.find("fbar_elastic_block_2d 2D linear") != std::string::npos);
+  // The two-phase schemes do not offer it: the scheme's located error.
+  r = loam_test::run_loam(
+      "bench --scenes fbar_two_phase_elastic_block_2d --threads 1 --steps 2 --repeat 1");
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("scheme.volumetric: unknown key") != std::string::npos);
+}

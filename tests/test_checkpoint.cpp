@@ -126,6 +126,16 @@ TEST_CASE("a resumed run with a rigid body under contact is bitwise the uninterr
                2000, 6000);
 }
 
+TEST_CASE("a resumed F-bar run is bitwise the uninterrupted one, 1 and 2 threads",
+          "[checkpoint][locking]") {
+  // configs/strip_footing_contact_2d.yaml with volumetric: fbar to 1 s (about 1000 steps): the
+  // averaged volume change and mean stress are rebuilt every step from the particles, so the
+  // checkpoint needs nothing of them (clay and the rigid footing on their own fields).
+  check_resume("strip_footing_contact_2d.yaml",
+               "--set scheme.volumetric=fbar --set time.end=1 --set output.every_time=0.25", 200,
+               600);
+}
+
 TEST_CASE("a resumed two-phase run is bitwise the uninterrupted one, 1 and 2 threads",
           "[checkpoint]") {
   // configs/seed001_terzaghi.yaml (two_phase_single_point, terzaghi reference) to t = 0.05 s

@@ -584,6 +584,11 @@ TEST_CASE("mpirun -np 1, 2 and 4: whole runs match the serial run, every shape f
                     disks(2, "bspline2", "{type: single_phase, update: musl, transfer: apic}")});
   scenes.push_back({"2D disks gimp tpic",
                     disks(2, "gimp", "{type: single_phase, update: musl, transfer: tpic}")});
+  // F-bar: its nodal averages are completed over the ranks after each of its scatters.
+  scenes.push_back({"2D disks gimp fbar",
+                    disks(2, "gimp", "{type: single_phase, update: musl, volumetric: fbar}")});
+  scenes.push_back({"3D disks bspline2 fbar",
+                    disks(3, "bspline2", "{type: single_phase, update: musl, volumetric: fbar}")});
   scenes.push_back({"3D disks linear usf apic",
                     disks(3, "linear", "{type: single_phase, update: usf, transfer: apic}")});
   // Two-phase (single point): a Terzaghi column under a traction, and saturated disks (a soft
