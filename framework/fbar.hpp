@@ -52,16 +52,7 @@ class Simulation;
 /// How a scheme treats the volume change of nearly incompressible flow.
 enum class Volumetric { kNone, kFbar };
 
-/// The `volumetric` parameter of a scheme.
-inline void add_volumetric_param(Schema& s, const std::string& applies_to) {
-  s.choice("volumetric", {"none", "fbar"},
-           "volumetric locking treatment of " + applies_to +
-               ": none (each particle's volume follows its own velocity gradient, det(I + L "
-               "dt)) or fbar (F-bar: each particle takes the volume change averaged through the "
-               "grid's nodes; de Souza Neto et al. 1996, Zhao, Jiang & Choo 2023; "
-               "docs/volumetric_locking.md)")
-      .def("none");
-}
+/// A scheme's `volumetric` parameter (fbar, or none: each particle's own volume change).
 inline Volumetric volumetric_of(const Params& p) {
   return p.text("volumetric") == "fbar" ? Volumetric::kFbar : Volumetric::kNone;
 }

@@ -39,7 +39,12 @@ class SinglePhase : public Scheme<D> {
              "grid update), usf (before forces)")
         .def("musl");
     add_transfer_params(s, "; with linear tents update: usf");
-    add_volumetric_param(s, "the particles' stress");
+    s.choice("volumetric", {"none", "fbar"},
+             "volumetric locking treatment of the particles' stress: none (each particle's "
+             "volume follows its own velocity gradient, det(I + L dt)) or fbar (F-bar: each "
+             "particle takes the volume change averaged through the grid's nodes; de Souza Neto "
+             "et al. 1996, Zhao, Jiang & Choo 2023; docs/volumetric_locking.md)")
+        .def("none");
     s.string_list("sets",
                   "names of the particle sets; all are summed onto the one velocity field (e.g. "
                   "a column split into two sets behaves as one), each has its own output frames")
