@@ -15,18 +15,16 @@
 // bilinear/trilinear field, one value per node) and the volumes V^n. The material updates its
 // stress with
 //   L_bar = (dF_bar - I) / dt = alpha L + (alpha - 1) / dt I,  alpha = (dJ_bar / dJ)^(1/D),
-// and the volume with det dF_bar = dJ_bar; the internal force keeps each particle's own stress.
-// (Taking the mean stress averaged the same way into the force, the B-bar form of Hughes 1980,
-// closes an elastic energy balance more tightly, but the nodal average of a stress that grows
-// with depth is one-sided at a free surface and a held base: the spurious force it left there
-// made a frictional layer with psi = 0 creep at its full strength; docs/volumetric_locking.md.)
-// The average is per node, not per cell (Q1-P0): two particles of one cell that expand and
-// contract alike have no volumetric stiffness in a cell mean, and under perfect plasticity
-// barely any deviatoric one, so the clay under a rigid footing blew up once particles crossed
-// into the next cell. Rigid motion keeps dJ = 1 everywhere, so it stays free of stress. Bodies
-// on their own velocity fields (contact) are averaged each on their own; a rigid body's
-// particles keep their own L. The nodal sums run in the scatter's colour-parallel blocks (the
-// same bits at a given thread count, as the P2G) and are completed over the ranks under mpirun.
+// and the volume with det dF_bar = dJ_bar; the internal force keeps each particle's own stress:
+// the mean stress averaged the same way (the B-bar form, Hughes 1980) is one-sided at a free
+// surface and a held base, a spurious force on a body at rest under gravity. The average is per
+// node, not per cell (Q1-P0): two particles of one cell that expand and contract alike have no
+// volumetric stiffness in a cell mean, and under perfect plasticity barely any deviatoric one
+// (docs/volumetric_locking.md gives the measurements behind both choices). Rigid motion keeps dJ =
+// 1 everywhere, so it stays free of stress. Bodies on their own velocity fields (contact) are
+// averaged each on their own; a rigid body's particles keep their own L. The nodal sums run in the
+// scatter's colour-parallel blocks (the same bits at a given thread count, as the P2G) and are
+// completed over the ranks under mpirun.
 #include <omp.h>
 
 #include <algorithm>
@@ -187,7 +185,7 @@ class Fbar {
   }
   /// Along a periodic axis a face node and its partner on the other face are one node (the
   /// periodic condition joins their masses and momenta the same way): each pair's sums go to
-  /// both. Without the join the layer of configs/infinite_slope_srf.yaml crept at 0.02 m/s.
+  /// both.
   void join_periodic(const Simulation<D>& sim, double* nodal) {
     if (periodic_pairs_.empty())
       for (int a = 0; a < D; ++a)

@@ -377,9 +377,10 @@ class SinglePhase : public Scheme<D> {
       double* L = scratch_[size_t(thread)]->L.data();
       double* V = P.col(P.volume) + b;
       const auto F = deformation_gradient_block(P, F_, b);
+      const size_t slot = sim.set_slot(set);
       for (int p = 0; p < count; ++p) {
         double l[D][D];
-        fbar_.averaged_gradient(sim.set_slot(set), b + size_t(p), dt, l);
+        fbar_.averaged_gradient(slot, b + size_t(p), dt, l);
         store_velocity_gradient<D>(l, L, p);
         update_volume_and_deformation<D>(l, dt, V[p], F, p);
       }
