@@ -9,27 +9,37 @@
 // and the collapse load comes out too high. F-bar relaxes the constraint to about one per node:
 // each particle's increment dF = I + L dt keeps its deviatoric part and takes the volume change
 // of its neighbourhood,
-//   dF_bar = (dJ_bar / dJ)^(1/D) dF,   dJ = det dF,
-//   dJ_bar(x_p) = sum_I N_I(x_p) dJ_I,  dJ_I = sum_q N_I(x_q) V_q dJ_q / sum_q N_I(x_q) V_q,
-// with the linear tents N of the particle's cell whatever the shape function (a continuous
-// bilinear/trilinear field, one value per node) and the volumes V^n. The material updates its
+//   dF_bar = (dJ_bar / dJ)^(1/D) dF,   dJ = det dF,   dJ_bar = P dJ,
+// where P projects a particle field onto the continuous (bi/tri)linear nodal field of the
+// linear tents N of each particle's cell (whatever the shape function), in the V-weighted L2
+// sense: nodal values a = M^-1 b, M_IJ = sum_p V_p N_I(x_p) N_J(x_p) (the consistent mass),
+// b_I = sum_p V_p N_I(x_p) f_p, and (P f)_p = sum_I N_I(x_p) a_I. The material updates its
 // stress with
 //   L_bar = (dF_bar - I) / dt = alpha L + (alpha - 1) / dt I,  alpha = (dJ_bar / dJ)^(1/D),
-// and the volume with det dF_bar = dJ_bar; the internal force keeps each particle's own stress:
-// the mean stress averaged the same way (the B-bar form, Hughes 1980) is one-sided at a free
-// surface and a held base, a spurious force on a body at rest under gravity. The average is per
-// node, not per cell (Q1-P0): two particles of one cell that expand and contract alike have no
-// volumetric stiffness in a cell mean, and under perfect plasticity barely any deviatoric one
-// (docs/volumetric_locking.md gives the measurements behind both choices). Rigid motion keeps dJ =
-// 1 everywhere, so it stays free of stress. Bodies on their own velocity fields (contact) are
-// averaged each on their own; a rigid body's particles keep their own L. The nodal sums run in the
-// scatter's colour-parallel blocks (the same bits at a given thread count, as the P2G) and are
-// completed over the ranks under mpirun.
+// and its volume with det dF_bar = dJ_bar. The internal force takes the mean normal stress
+// projected the same way, f_I = sum_p V_p (sigma_p + (P m - m)_p I) grad N_I (m = sum_d
+// sigma_dd / D): the B-bar form (Hughes 1980), whose power is the stress power sum_p V_p
+// sigma_p : L_bar_p the materials store, because P is symmetric in the V-weighted product.
+// Without that consistency dilatant flow gains energy: the dilating band of an infinite slope
+// (psi = phi) heaved and failed at 0.84 of its strength. P reproduces every linear field, at a
+// free surface and a held base too, so a body at rest under gravity feels the force it would
+// without F-bar; a lumped nodal average (b_I / sum_J M_IJ) is one-sided there, and its spurious
+// force made a frictional layer with psi = 0 creep at full strength (docs/volumetric_locking.md).
+// The average is per node, not per cell (Q1-P0): two particles of one cell that expand and
+// contract alike have no volumetric stiffness in a cell mean. Rigid motion keeps dJ = 1, so it
+// stays free of stress. Bodies on their own velocity fields (contact) are projected each on
+// their own; a rigid body's particles keep their own L. M is assembled each step in the
+// scatter's colour-parallel blocks (the same bits on any number of threads, as the P2G) and
+// solved by a fixed number of conjugate-gradient steps preconditioned with its row sums;
+// products and sums are completed over the ranks under mpirun and joined across periodic
+// faces. The projection is global: an error at a body's face (where nodal velocities are
+// averages) reaches into it, decaying by about a third per cell.
 #include <omp.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <string>
 #include <utility>
 #include <vector>
@@ -55,6 +65,29 @@ inline Volumetric volumetric_of(const Params& p) {
   return p.text("volumetric") == "fbar" ? Volumetric::kFbar : Volumetric::kNone;
 }
 
+/// det(I + A) - 1 with A = L dt, without the cancellation of det(I + A) - 1 in floating point:
+/// tr A + the sum of A's principal 2 x 2 minors + det A. F-bar projects this change rather than
+/// the ratio itself: the solve's round-off then scales with the change, and a rigid spin (a
+/// change of (omega dt)^2) stays free of stress.
+template <int D>
+double volume_change(const double (&l)[D][D], double dt) {
+  double a[D][D];
+  for (int i = 0; i < D; ++i)
+    for (int j = 0; j < D; ++j) a[i][j] = l[i][j] * dt;
+  if constexpr (D == 1) {
+    return a[0][0];
+  } else if constexpr (D == 2) {
+    return a[0][0] + a[1][1] + (a[0][0] * a[1][1] - a[0][1] * a[1][0]);
+  } else {
+    const double minors = a[0][0] * a[1][1] - a[0][1] * a[1][0] + a[0][0] * a[2][2] -
+                          a[0][2] * a[2][0] + a[1][1] * a[2][2] - a[1][2] * a[2][1];
+    const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+                       a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                       a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    return a[0][0] + a[1][1] + a[2][2] + minors + det;
+  }
+}
+
 template <int D>
 class Fbar {
  public:
@@ -72,18 +105,21 @@ class Fbar {
     groups_ = groups;
     stores_.resize(sim.sets.size());
     for (size_t set = 0; set < sim.sets.size(); ++set) locate_set(sim, set);
-    weights_.assign(size_t(groups) * sim.grid.num_nodes, 0.0);
-    scatter(sim, group, weights_, nullptr);
+    row_offsets(sim.grid);
+    weights_.assign(size_t(groups) * sim.grid.num_nodes + 2 * pad_, 0.0);
+    scatter(sim, group, at(weights_), nullptr);
+    index_nodes(sim);
+    assemble_mass(sim, group);
   }
 
-  /// Keep particle i's velocity gradient and volume ratio det(I + L dt) (set slot `set`); the
-  /// stress update waits for project_volume_ratios().
+  /// Keep particle i's velocity gradient and volume change det(I + L dt) - 1 (set slot `set`);
+  /// the stress update waits for project_volume_ratios().
   void keep(size_t set, size_t i, const double (&l)[D][D], double dt) {
     Store& s = stores_[set];
     double* dst = s.l.data() + i * size_t(D * D);
     for (int a = 0; a < D; ++a)
       for (int b = 0; b < D; ++b) dst[a * D + b] = l[a][b];
-    s.dj[i] = det_increment<D>(l, dt);
+    s.dj[i] = volume_change<D>(l, dt);
   }
   /// Size the kept gradients and volume ratios of every set before a gradient pass.
   void resize(const Simulation<D>& sim) {
@@ -99,6 +135,38 @@ class Fbar {
     project(sim, group, &Store::dj, &Store::dj_bar);
   }
 
+  /// The shift m_bar - m of each particle's mean normal stress over the D axes, m = sum_d
+  /// sigma_dd / D, to its projection, which the internal force adds to sigma_dd (the header's
+  /// B-bar form); shifts(set) after.
+  template <class Group>
+  void project_mean_stress(Simulation<D>& sim, Group&& group) {
+    for (size_t set = 0; set < stores_.size(); ++set) {
+      const Particles<D>& P = sim.sets[set].particles;
+      std::array<const double*, D> sig{};
+      for (int d = 0; d < D; ++d) sig[size_t(d)] = P.col(P.stress, voigt_index(d, d));
+      std::vector<double>& m = stores_[set].mean;
+      m.resize(P.size());
+      const long np = long(P.size());
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+      for (long i = 0; i < np; ++i) {
+        double sum = 0;
+        for (int d = 0; d < D; ++d) sum += sig[size_t(d)][i];
+        m[size_t(i)] = sum / D;
+      }
+    }
+    project(sim, group, &Store::mean, &Store::shift);
+    for (Store& s : stores_) {
+      double* shift = s.shift.data();
+      const double* m = s.mean.data();
+      const long np = long(s.shift.size());
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+      for (long i = 0; i < np; ++i) shift[i] -= m[i];
+    }
+  }
+  const double* shifts(size_t set) const {
+    return stores_[set].shift.data();
+  }
+
   /// Particle i's L_bar (the header's equation); its own L where a volume ratio is not
   /// positive (the step's stability check reports the inverted particle).
   void averaged_gradient(size_t set, size_t i, double dt, double (&l)[D][D]) const {
@@ -106,7 +174,7 @@ class Fbar {
     const double* src = s.l.data() + i * size_t(D * D);
     for (int a = 0; a < D; ++a)
       for (int b = 0; b < D; ++b) l[a][b] = src[a * D + b];
-    const double dj = s.dj[i], dj_bar = s.dj_bar[i];
+    const double dj = 1 + s.dj[i], dj_bar = 1 + s.dj_bar[i];
     if (!(dj > 0 && dj_bar > 0)) return;
     const double ratio = dj_bar / dj;
     const double alpha = D == 1 ? ratio : D == 2 ? std::sqrt(ratio) : std::cbrt(ratio);
@@ -117,11 +185,25 @@ class Fbar {
   }
 
  private:
-  static constexpr int K = 1 << D;  // a cell's corners
+  static constexpr int K = 1 << D;                        // a cell's corners
+  static constexpr int S = D == 1 ? 3 : D == 2 ? 9 : 27;  // a node's row: the 3^D around it
+  static constexpr int kProducts = 20;                    // the solve's conjugate-gradient steps
+  /// kEntry[k][l]: the entry of corner l in the row of corner k (offset l - k per axis).
+  static constexpr std::array<std::array<int, K>, K> entries() {
+    std::array<std::array<int, K>, K> e{};
+    for (int k = 0; k < K; ++k)
+      for (int l = 0; l < K; ++l) {
+        int o = 0, p3 = 1;
+        for (int d = 0; d < D; ++d, p3 *= 3) o += (((l >> d) & 1) - ((k >> d) & 1) + 1) * p3;
+        e[size_t(k)][size_t(l)] = o;
+      }
+    return e;
+  }
+  static constexpr std::array<std::array<int, K>, K> kEntry = entries();
   struct Store {
-    std::vector<double> l, dj, dj_bar;  // D x D, 1, 1 per particle
-    std::vector<size_t> corner;         // the cell's lower corner (stored node)
-    std::vector<double> wv;             // V_p N_I(x_p) of the K corners
+    std::vector<double> l, dj, dj_bar, mean, shift, tmp;  // D x D, then 1 each per particle
+    std::vector<size_t> corner;                           // the cell's lower corner (stored node)
+    std::vector<double> wv;                               // V_p N_I(x_p) of the K corners
   };
 
   void locate_set(const Simulation<D>& sim, size_t set) {
@@ -159,11 +241,10 @@ class Fbar {
   /// without values), by the colour-parallel scatter (race-free: a cell's corners are in the
   /// stencil the partition was made for), completed over the ranks.
   template <class Group>
-  void scatter(Simulation<D>& sim, Group& group, std::vector<double>& nodal,
+  void scatter(Simulation<D>& sim, Group& group, double* const out,
                std::vector<double> Store::*values) {
     const size_t nodes = sim.grid.num_nodes;
     const std::array<size_t, K> offset = corner_offsets(sim.grid);
-    double* const out = nodal.data();
     sim.scatter_blocks([&](ParticleSet<D>& set, size_t b, int count, int) {
       const size_t slot = sim.set_slot(set);
       const Store& s = stores_[slot];
@@ -178,10 +259,15 @@ class Fbar {
         for (int k = 0; k < K; ++k) node[offset[size_t(k)]] += wv[i * K + size_t(k)] * fi;
       }
     });
+    complete(sim, out);
+  }
+  /// A scatter's nodal sums completed over the ranks and joined across periodic faces.
+  void complete(Simulation<D>& sim, double* nodal) {
+    const size_t nodes = sim.grid.num_nodes;
     std::vector<NodalArray> arrays;
-    for (int g = 0; g < groups_; ++g) arrays.push_back({out + size_t(g) * nodes, 1, 1});
+    for (int g = 0; g < groups_; ++g) arrays.push_back({nodal + size_t(g) * nodes, 1, 1});
     sim.complete_nodes(arrays);
-    join_periodic(sim, out);
+    join_periodic(sim, nodal);
   }
   /// Along a periodic axis a face node and its partner on the other face are one node (the
   /// periodic condition joins their masses and momenta the same way): each pair's sums go to
@@ -203,25 +289,176 @@ class Fbar {
   }
 
   /// (s.*out)[i] = (s.*in)[i] projected onto the continuous (bi/tri)linear nodal field of its
-  /// group: sum_p V_p N_I(x_p) in_p / W_I at the nodes, sum_I N_I(x_p) of that at the
-  /// particle; in itself for kNoGroup.
+  /// group in the V-weighted L2 sense: the nodal values a solve M a = b with the consistent
+  /// mass M_IJ = sum_p V_p N_I(x_p) N_J(x_p) and b_I = sum_p V_p N_I(x_p) in_p, and each
+  /// particle takes sum_I N_I(x_p) a_I; in itself for kNoGroup. The projection is symmetric
+  /// in the V-weighted product and reproduces every linear field, at free surfaces and held
+  /// faces too (the lumped average b_I / W_I is one-sided there).
   template <class Group>
   void project(Simulation<D>& sim, Group& group, std::vector<double> Store::*in,
                std::vector<double> Store::*out) {
-    const size_t nodes = sim.grid.num_nodes;
-    values_.assign(size_t(groups_) * nodes, 0.0);
-    scatter(sim, group, values_, in);
-    const long n_all = long(values_.size());
-    double* mean = values_.data();
-    const double* W = weights_.data();
+    std::fill(rhs_.begin(), rhs_.end(), 0.0);
+    scatter(sim, group, at(rhs_), in);
+    solve_consistent_mass(sim);
+    gather(sim, group, at(nodal_), in, out);
+  }
+
+  /// nodal_ ~ M^-1 rhs_ by kProducts conjugate-gradient steps preconditioned with the lumped
+  /// mass W (the row sums of M), from the lumped solution rhs_ / W. W^-1 M is row-stochastic,
+  /// its spectrum in (0, 1] and about [1/2^D, 1] where cells are full; conjugate gradients
+  /// also resolve the few small eigenvalues of nodes that a partly filled cell's particles
+  /// hardly see, which a fixed polynomial (Chebyshev) left unconverged. The count is fixed: a
+  /// stopping test on the residual flips its count with round-off, and a run on ranks then left
+  /// the serial one by far more than round-off (1e-8 against 5e-13 in kinetic energy); with a
+  /// fixed count the result is continuous in its data. 20 steps: with 12 a rigid spin's
+  /// face error still reached 12 cells into the block above 1e-9 of E omega dt.
+  void solve_consistent_mass(Simulation<D>& sim) {
+    const double* W = at(weights_);
+    const double* b = at(rhs_);
+    double *a = at(nodal_), *r = at(res_), *p = at(dir_), *z = at(pre_), *q = at(prod_);
+    const size_t* act = active_.data();
+    const long na = long(active_.size());
 #pragma omp parallel for schedule(static) num_threads(sim.threads)
-    for (long n = 0; n < n_all; ++n) mean[n] = W[n] > 0 ? mean[n] / W[n] : 0.0;
+    for (long j = 0; j < na; ++j) a[act[j]] = b[act[j]] / W[act[j]];
+    apply_mass(sim, a, q);
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+    for (long j = 0; j < na; ++j) {
+      const size_t k = act[j];
+      r[k] = b[k] - q[k];
+      p[k] = r[k] / W[k];
+    }
+    double rz = dot(sim, r, p);
+
+    for (int it = 0; it < kProducts; ++it) {
+      apply_mass(sim, p, q);
+      const double pq = dot(sim, p, q);
+      if (!(rz > 0 && pq > 0)) break;  // solved exactly (a zero right-hand side)
+      const double alpha = rz / pq;
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+      for (long j = 0; j < na; ++j) {
+        const size_t k = act[j];
+        a[k] += alpha * p[k];
+        r[k] -= alpha * q[k];
+        z[k] = r[k] / W[k];
+      }
+      const double rz_next = dot(sim, r, z);
+      const double beta = rz_next / rz;
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+      for (long j = 0; j < na; ++j) p[act[j]] = z[act[j]] + beta * p[act[j]];
+      rz = rz_next;
+    }
+  }
+  /// The sum of x y over the counted nodes in fixed chunks (the same bits on any number of
+  /// threads), summed over the ranks.
+  double dot(const Simulation<D>& sim, const double* x, const double* y) {
+    constexpr size_t kChunk = 1024;
+    const size_t* c = counted_.data();
+    const size_t n = counted_.size(), chunks = (n + kChunk - 1) / kChunk;
+    chunk_sums_.assign(chunks, 0.0);
+    double* part = chunk_sums_.data();
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+    for (long ch = 0; ch < long(chunks); ++ch) {
+      double sum = 0;
+      for (size_t j = size_t(ch) * kChunk; j < std::min(n, size_t(ch + 1) * kChunk); ++j)
+        sum += x[c[j]] * y[c[j]];
+      part[ch] = sum;
+    }
+    double sum = 0;
+    for (size_t ch = 0; ch < chunks; ++ch) sum += part[ch];
+    sum_over_ranks(*sim.ranks, sum);
+    return sum;
+  }
+  /// The consistent mass of every group, as each node's row over the 3^D nodes around it:
+  /// mass_[(g nodes + I) S + o] = sum_p V_p N_I N_{I+o} over this rank's particles (the rows of
+  /// nodes shared with other ranks are partial; apply_mass completes the product).
+  template <class Group>
+  void assemble_mass(Simulation<D>& sim, Group& group) {
+    const size_t nodes = sim.grid.num_nodes;
+    mass_.assign(size_t(groups_) * nodes * S, 0.0);
+    const std::array<size_t, K> offset = corner_offsets(sim.grid);
+    double* const out = mass_.data();
+    sim.scatter_blocks([&](ParticleSet<D>& set, size_t b, int count, int) {
+      const size_t slot = sim.set_slot(set);
+      const Store& s = stores_[slot];
+      const double* V = set.particles.col(set.particles.volume);
+      const double* wv = s.wv.data();
+      const size_t* corner = s.corner.data();
+      for (size_t i = b; i < b + size_t(count); ++i) {
+        const int g = group(slot, i);
+        if (g == kNoGroup) continue;
+        const double* w = wv + i * K;
+        const double inv = 1.0 / V[i];
+        double* row0 = out + (size_t(g) * nodes + corner[i]) * S;
+        for (int k = 0; k < K; ++k) {
+          double* row = row0 + offset[size_t(k)] * S;
+          const double wk = w[k] * inv;
+          for (int l = 0; l < K; ++l) row[kEntry[size_t(k)][size_t(l)]] += wk * w[l];
+        }
+      }
+    });
+  }
+  /// The stored-node offset of each entry of a node's row, and the padding that lets a row be
+  /// read at any node of the box.
+  void row_offsets(const Grid<D>& g) {
+    pad_ = 0;
+    for (int o = 0; o < S; ++o) {
+      long off = 0;
+      for (int d = 0, r = o; d < D; ++d, r /= 3) off += (r % 3 - 1) * g.node_stride[size_t(d)];
+      entry_offset_[size_t(o)] = off;
+      pad_ = std::max(pad_, size_t(std::labs(off)));
+    }
+  }
+  /// The nodes the solve runs over (a mass in their group), those dot() counts (this rank's
+  /// own, a periodic pair once), and the solve's vectors sized with pad_ zeros on both sides.
+  void index_nodes(const Simulation<D>& sim) {
+    const size_t nodes = sim.grid.num_nodes, n_all = size_t(groups_) * nodes;
+    std::vector<uint8_t> partner(nodes, 0);
+    for (const auto& pr : periodic_pairs_) partner[pr.second] = 1;
+    active_.clear();
+    counted_.clear();
+    const double* W = at(weights_);
+    for (size_t k = 0; k < n_all; ++k) {
+      if (!(W[k] > 0)) continue;
+      active_.push_back(k);
+      const size_t node = k % nodes;
+      if (!partner[node] &&
+          (!sim.ranks->distributed() || sim.ranks->owns_node(sim.grid, sim.grid.node_ijk(node))))
+        counted_.push_back(k);
+    }
+    for (auto* v : {&rhs_, &nodal_, &res_, &dir_, &pre_, &prod_}) v->assign(n_all + 2 * pad_, 0.0);
+  }
+
+  /// y = M x at the active nodes: each rank's rows, completed over the ranks and joined across
+  /// periodic faces as a scatter's sums are.
+  void apply_mass(Simulation<D>& sim, const double* x, double* y) {
+    const double* M = mass_.data();
+    const size_t* act = active_.data();
+    const long na = long(active_.size());
+    const std::array<long, S> off = entry_offset_;
+#pragma omp parallel for schedule(static) num_threads(sim.threads)
+    for (long j = 0; j < na; ++j) {
+      const size_t k = act[j];
+      const double* row = M + k * S;
+      double sum = 0;
+      for (int o = 0; o < S; ++o) sum += row[o] * x[long(k) + off[size_t(o)]];
+      y[k] = sum;
+    }
+    complete(sim, y);
+  }
+  double* at(std::vector<double>& v) {
+    return v.data() + pad_;
+  }
+  /// (s.*out)[i] = sum_I N_I(x_p) nodal_I of its group; (s.*in)[i] for kNoGroup (0 without in).
+  template <class Group>
+  void gather(Simulation<D>& sim, Group& group, const double* nodal, std::vector<double> Store::*in,
+              std::vector<double> Store::*out) {
+    const size_t nodes = sim.grid.num_nodes;
     const std::array<size_t, K> offset = corner_offsets(sim.grid);
     for (size_t set = 0; set < stores_.size(); ++set) {
       Store& s = stores_[set];
       const double* V = sim.sets[set].particles.col(sim.sets[set].particles.volume);
       (s.*out).resize(s.corner.size());
-      const double* f = (s.*in).data();
+      const double* f = in ? (s.*in).data() : nullptr;
       double* o = (s.*out).data();
       const double* wv = s.wv.data();
       const size_t* corner = s.corner.data();
@@ -230,10 +467,10 @@ class Fbar {
       for (long i = 0; i < np; ++i) {
         const int g = group(set, size_t(i));
         if (g == kNoGroup) {
-          o[i] = f[i];
+          o[i] = f ? f[i] : 0.0;
           continue;
         }
-        const double* node = mean + size_t(g) * nodes + corner[i];
+        const double* node = nodal + size_t(g) * nodes + corner[i];
         double sum = 0;
         for (int k = 0; k < K; ++k) sum += wv[size_t(i) * K + size_t(k)] * node[offset[size_t(k)]];
         o[i] = sum / V[i];  // sum_k wv_k = V_p
@@ -251,9 +488,14 @@ class Fbar {
 
   bool on_ = false;
   int groups_ = 1;
-  std::vector<Store> stores_;    // per set
-  std::vector<double> weights_;  // per group and node: W_I
-  std::vector<double> values_;   // per group and node: sum V N value, then its mean
+  std::vector<Store> stores_;                                 // per set
+  std::vector<double> weights_;                               // per group and node: W_I
+  std::vector<double> rhs_, nodal_, res_, dir_, pre_, prod_;  // per group and node: the solve
+  std::vector<double> mass_;                                  // per group and node: S entries
+  std::array<long, S> entry_offset_{};                        // stored-node offset of entry o
+  std::vector<size_t> active_, counted_;  // group-major node indices: the solve's, dot()'s
+  std::vector<double> chunk_sums_;        // dot()
+  size_t pad_ = 0;                        // zeros before and after the solve's nodal vectors
   std::vector<std::pair<size_t, size_t>> periodic_pairs_;  // join_periodic
 };
 

@@ -37,8 +37,10 @@ void Partition<D>::sort(Particles<D>& p, const Grid<D>& g, int num_materials, in
     material_ranges[size_t(m)] = {counts_[size_t(m) * ncells], counts_[size_t(m + 1) * ncells]};
 
   // Cut the cell order into slabs of equal particle count (cuts may fall inside a row), as many
-  // as keep same-colour slabs apart: 2 per colour per thread, fewer if the slabs get too thin.
-  // Balanced slabs matter: a colour phase lasts as long as its busiest thread.
+  // as keep same-colour slabs apart, up to kMaxSlabs. Balanced slabs matter: a colour phase
+  // lasts as long as its busiest thread. The slabs do not depend on the thread count, so neither
+  // does the order in which a node's sums are added (header): a run gives the same bits on
+  // any number of threads.
   std::vector<size_t> before(ncells + 1, 0);  // particles in cells < c, over all materials
   for (size_t c = 0; c <= ncells; ++c)
     for (int m = 0; m < num_materials; ++m)
@@ -64,8 +66,7 @@ void Partition<D>::sort(Particles<D>& p, const Grid<D>& g, int num_materials, in
   };
   // One spare row between same-colour slabs, so particles may drift before a re-sort is due.
   constexpr int kMargin = 1;
-  int num_slabs = threads > 1 ? 8 * threads : 1;
-  for (; num_slabs >= 3; num_slabs -= 2) {
+  for (int num_slabs = kMaxSlabs; num_slabs >= 3; num_slabs -= 2) {
     build(num_slabs);
     if (separated(p, g, reach, kMargin)) return;
   }
@@ -90,7 +91,7 @@ bool Partition<D>::separated(const Particles<D>& p, const Grid<D>& g, int reach,
     slab.row_min = lo;
     slab.row_max = hi;
   }
-  if (threads <= 1 || slabs.size() < 3) return true;
+  if (slabs.size() < 3) return true;
   // Same-colour slabs must be further apart than the stencil reach (plus the margin).
   for (int colour = 0; colour < 2; ++colour) {
     int last_max = -(1 << 29);

@@ -9,7 +9,10 @@
 // rows than the stencil reaches, so they never write the same node, and a
 // particle-to-grid scatter runs race-free without atomics or locks: all colour-0 slabs in
 // parallel, then all colour-1 slabs (docs/architecture.md "Threads without locks";
-// measured 1.7-1.8x on 2 threads).
+// measured 1.7-1.8x on 2 threads). A node is written by at most two neighbouring slabs, the
+// colour-0 one first, each in its particle order, whichever thread runs them; the slabs are
+// cut without regard to the thread count, and one thread runs them in the same colour order,
+// so a node's sums, and the whole run, have the same bits on any number of threads.
 //
 // Between sorts particles drift; verify() measures each slab's actual row extent every step and
 // reports when the colouring is no longer safe, so the caller re-sorts.
@@ -37,6 +40,9 @@ class Partition {
     int row_min = 0, row_max = -1;   // actual rows spanned now
   };
 
+  /// The most slabs a sort cuts (fewer where they would get too thin for the stencil).
+  static constexpr int kMaxSlabs = 64;
+
   std::vector<Slab> slabs;
   std::vector<IndexRange> material_ranges;
   int threads = 1;
@@ -53,12 +59,12 @@ class Partition {
   /// f(begin, count, thread) with count <= kBlock; never spans two materials.
   template <class F>
   void scatter_blocks(F&& f) const {
-    if (threads <= 1 || slabs.size() < 3) {
-      for (const auto& s : slabs) run_slab(s, f, 0);
-      return;
-    }
+    const int n = int(slabs.size());
     for (int colour = 0; colour < 2; ++colour) {
-      const int n = int(slabs.size());
+      if (threads <= 1 || n < 3) {
+        for (int s = colour; s < n; s += 2) run_slab(slabs[size_t(s)], f, 0);
+        continue;
+      }
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
       for (int s = colour; s < n; s += 2) run_slab(slabs[size_t(s)], f, omp_get_thread_num());
     }

@@ -340,14 +340,12 @@ void Run<D>::restore_checkpoint() {
         }
     set.last_sort = long(r.scalar(pre + "last_sort"));
     set.resized = r.scalar(pre + "resized") != 0;
+    // The slabs do not depend on the thread count (framework/partition.hpp): a run resumed on
+    // another number of threads keeps its block order and its bits.
     const auto part = r.doubles(pre + "partition");
-    if (int(part[0]) != sim.threads) {  // another thread count: its own block order
-      sim.sort(set);
-      continue;
-    }
     size_t i = 1;
     auto next = [&] { return size_t(part.at(i++)); };
-    set.partition.threads = int(part[0]);
+    set.partition.threads = sim.threads;
     set.partition.material_ranges.assign(next(), {});
     for (auto& m : set.partition.material_ranges) m.begin = next(), m.end = next();
     set.partition.slabs.assign(next(), {});

@@ -42,8 +42,9 @@ class SinglePhase : public Scheme<D> {
     s.choice("volumetric", {"none", "fbar"},
              "volumetric locking treatment of the particles' stress: none (each particle's "
              "volume follows its own velocity gradient, det(I + L dt)) or fbar (F-bar: each "
-             "particle takes the volume change averaged through the grid's nodes; de Souza Neto "
-             "et al. 1996, Zhao, Jiang & Choo 2023; docs/volumetric_locking.md)")
+             "particle takes the volume change projected onto the grid's nodes, the internal "
+             "force the mean stress projected the same way; de Souza Neto et al. 1996, Hughes "
+             "1980; docs/volumetric_locking.md)")
         .def("none");
     s.string_list("sets",
                   "names of the particle sets; all are summed onto the one velocity field (e.g. "
@@ -300,7 +301,7 @@ class SinglePhase : public Scheme<D> {
   /// fields, with their volume and its gradient).
   template <int NPP, bool MOMENTUM, bool FORCE, Fields FIELDS>
   void scatter_all(Simulation<D>& sim) {
-    if (MOMENTUM && fbar_.on()) sim.timed("fbar", [&] { fbar_locate<FIELDS>(sim); });
+    if (fbar_.on()) sim.timed("fbar", [&] { fbar_before_scatter<MOMENTUM, FORCE, FIELDS>(sim); });
     // APIC's P2G is its own instantiation per form: the FLIP loop stays as it is without it.
     // Contact takes FLIP only (setup).
     sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
@@ -360,11 +361,14 @@ class SinglePhase : public Scheme<D> {
       });
     }
   }
-  /// F-bar at the step's first scatter: where the particles are (framework/fbar.hpp).
-  template <Fields FIELDS>
-  void fbar_locate(Simulation<D>& sim) {
-    with_fbar_groups<FIELDS>(sim,
-                             [&](int groups, auto group) { fbar_.locate(sim, groups, group); });
+  /// F-bar at a scatter: where the particles are (the step's first scatter), and the mean
+  /// stress projected for the internal force (framework/fbar.hpp).
+  template <bool MOMENTUM, bool FORCE, Fields FIELDS>
+  void fbar_before_scatter(Simulation<D>& sim) {
+    with_fbar_groups<FIELDS>(sim, [&](int groups, auto group) {
+      if (MOMENTUM) fbar_.locate(sim, groups, group);
+      if (FORCE) fbar_.project_mean_stress(sim, group);
+    });
   }
   /// F-bar (framework/fbar.hpp): the kept velocity gradients' volume ratios projected per
   /// velocity field, then each particle's volume, F and stress from its L_bar.
@@ -407,6 +411,8 @@ class SinglePhase : public Scheme<D> {
       fe[size_t(d)] = sim.external_force >= 0 ? P.col(sim.external_force, d) + b : nullptr;
     }
     for (int c = 0; c < NS; ++c) sig[size_t(c)] = P.col(P.stress, c) + b;
+    // F-bar: the projected mean stress in the force (Fbar::project_mean_stress).
+    const double* shift = FORCE && fbar_.on() ? fbar_.shifts(sim.set_slot(set)) + b : nullptr;
     const std::array<double, D> gravity = sim.gravity;
     typename AffineTransfer<D>::Stencil as;
     typename AffineTransfer<D>::template Momenta<NPP, FORM> am;  // APIC: momenta per weight
@@ -424,6 +430,8 @@ class SinglePhase : public Scheme<D> {
         body[d] = mp * gravity[size_t(d)] + (fe[size_t(d)] ? fe[size_t(d)][p] : 0.0);
         for (int j = 0; j < D; ++j) sv[d][j] = V[p] * sig[size_t(voigt_index(d, j))][p];
       }
+      if (shift)
+        for (int d = 0; d < D; ++d) sv[d][d] += V[p] * shift[p];
       if constexpr (AFFINE) {  // APIC: m_p (N v_p + B_p D_p^-1 N (x_I - x_p)), see the header
         double mC[D][D];       // m_p B_p D_p^-1
         affine_.stencil(P, st, p, b + size_t(p), npp, as);

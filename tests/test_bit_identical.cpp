@@ -1,19 +1,11 @@
 // Refactoring guard: particle frames of existing single-set scenes must stay bit-identical when
-// the code is restructured without changing the physics (issue 12: particle sets, shared step
-// building blocks). Each scene runs a short stretch on 1 thread (the scatter's summation order
-// depends on the thread count) and every dataset of its last particle frame is hashed (FNV-1a
-// over the raw bytes, dataset names included). The expected hashes in
-// tests/data/frame_checksums.txt were recorded on main at 6b6c6a1, before the particle-set
-// refactor; elastic_column_3d_cpdi was re-recorded when CPDI merged its corner stencils into 3^D
-// nodes (the same weights, summed per node before the scatter instead of in it: the frames of
-// that scene differ from the old ones by 6e-15 relative in stress after 27 steps, 4e-14 after
-// 329). granular_collapse_gimp was re-recorded when nodes lighter than mass_tolerance kept
-// their points' mean velocity instead of zero (docs/verification.md M, particles on node lines):
-// GIMP's round-off weights at the edge of its support reach such nodes, and the frames differ
-// from the old ones by 3e-13 m in position and 4e-8 Pa (4e-12 relative) in stress after 0.03 s.
-// The two-phase bspline2 scenes and the double-point ones (each set's last frame on its own
-// line) were recorded after the per-shape-function pressure projection and the pores filled by
-// point (docs/verification.md C and F).
+// the code is restructured without changing the physics (particle sets, shared step building
+// blocks). Each scene runs a short stretch on 1 and on 2 threads, which must give the same bits
+// (the scatter's slabs and their order do not depend on the thread count:
+// framework/partition.hpp), and every dataset of its last particle frame is hashed (FNV-1a over
+// the raw bytes, dataset names included). The expected hashes are in
+// tests/data/frame_checksums.txt (each set of a two-set scene on its own line); why and by how
+// much each was re-recorded is in the commit that did it.
 // A change that alters the numbers on purpose (new physics, a fix) re-records them with
 //   LOAM_RECORD_CHECKSUMS=1 build/loam_tests "particle frames*"
 // and says so in its commit message.
@@ -115,20 +107,29 @@ TEST_CASE("particle frames of existing scenes are bit-identical to the recorded 
   const auto expected = read_expected(table);
   std::ostringstream recorded;
   for (const auto& s : kScenes) {
-    TempDir dir("bitid_" + s.name);
-    run_scene(s.config, dir.path, "--threads 1 " + s.overrides);
-    const auto frames = last_frames(dir.path);
-    REQUIRE(!frames.empty());
-    for (const auto& [set, frame] : frames) {
-      // One set keeps the scene's name; each set of a two-set scene gets its own line.
-      const std::string name = frames.size() == 1 ? s.name : s.name + "_" + set;
-      char hex[17];
-      std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)hash_frame(frame));
-      recorded << name << " " << hex << "\n";
-      INFO(name << ": last frame " << frame.filename().string() << " hash " << hex);
-      if (!record) {
-        REQUIRE(expected.count(name) == 1);
-        CHECK(expected.at(name) == hex);
+    std::map<std::string, std::string> one_thread;  // set name -> hash
+    for (const int threads : {1, 2}) {
+      TempDir dir("bitid_" + s.name);
+      run_scene(s.config, dir.path, "--threads " + std::to_string(threads) + " " + s.overrides);
+      const auto frames = last_frames(dir.path);
+      REQUIRE(!frames.empty());
+      for (const auto& [set, frame] : frames) {
+        // One set keeps the scene's name; each set of a two-set scene gets its own line.
+        const std::string name = frames.size() == 1 ? s.name : s.name + "_" + set;
+        char hex[17];
+        std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)hash_frame(frame));
+        INFO(name << " on " << threads << " thread(s): last frame " << frame.filename().string()
+                  << " hash " << hex);
+        if (threads == 1) {
+          one_thread[name] = hex;
+          recorded << name << " " << hex << "\n";
+        } else {
+          CHECK(one_thread.at(name) == hex);  // the same bits on any number of threads
+        }
+        if (!record) {
+          REQUIRE(expected.count(name) == 1);
+          CHECK(expected.at(name) == hex);
+        }
       }
     }
   }

@@ -1039,13 +1039,28 @@ TEST_CASE("mpirun: strength reduction on ranks finds the serial factor of safety
           s0["trials"][k]["status"].get<std::string>().c_str(),
           s0["trials"][k]["steps"].get<long>());
     std::printf("\n");
+    // A trial that comes to rest just before max_time is decided by patience, and the ranks'
+    // summation order can move it across (docs/strength_reduction.md, "A verdict near the
+    // factor"): outcomes may differ only for a trial that ended static in the last tenth of
+    // max_time in one of the two runs; the factor must then stay within one bisection step.
     CHECK(s["status"] == s0["status"]);
-    CHECK(s["factor_of_safety"] == s0["factor_of_safety"]);
     REQUIRE(s["trials"].size() == s0["trials"].size());
+    const double max_time = 1.0;
+    auto late_rest = [&](const nlohmann::json& t) {
+      return t["status"] == "static" && t["time"].get<double>() > 0.9 * max_time;
+    };
+    bool same = true;
     for (size_t k = 0; k < s0["trials"].size(); ++k) {
-      CHECK(s["trials"][k]["factor"] == s0["trials"][k]["factor"]);
-      CHECK(s["trials"][k]["status"] == s0["trials"][k]["status"]);
+      const auto &a = s["trials"][k], &b = s0["trials"][k];
+      if (a["factor"] != b["factor"]) break;  // the bisection parted after a late rest
+      if (a["status"] == b["status"]) continue;
+      same = false;
+      INFO("trial F = " << a["factor"] << ": " << a.dump() << " against " << b.dump());
+      CHECK((late_rest(a) || late_rest(b)));
     }
+    if (same) CHECK(s["factor_of_safety"] == s0["factor_of_safety"]);
+    CHECK(std::fabs(s["factor_of_safety"].get<double>() - s0["factor_of_safety"].get<double>()) <=
+          s0["tolerance"].get<double>() * (1 + 1e-9));
     // The failure mechanism's frame (serially particles_000003_strength_reduction.h5): the
     // first rank's piece (the first block holds the cut's foot).
     CHECK(fs::exists(dir.path / out / "particles_000003_strength_reduction_r0000.h5"));
