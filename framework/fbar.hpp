@@ -121,7 +121,7 @@ class Fbar {
       for (int b = 0; b < D; ++b) dst[a * D + b] = l[a][b];
     s.dj[i] = volume_change<D>(l, dt);
   }
-  /// Size the kept gradients and volume ratios of every set before a gradient pass.
+  /// Size the kept gradients and volume changes of every set before a gradient pass.
   void resize(const Simulation<D>& sim) {
     for (size_t s = 0; s < sim.sets.size(); ++s) {
       stores_[s].l.resize(sim.sets[s].size() * size_t(D * D));
@@ -129,7 +129,7 @@ class Fbar {
     }
   }
 
-  /// The kept volume ratios projected: dJ_bar of every particle.
+  /// The kept volume changes projected: dJ_bar - 1 of every particle.
   template <class Group>
   void project_volume_ratios(Simulation<D>& sim, Group&& group) {
     project(sim, group, &Store::dj, &Store::dj_bar);
@@ -167,8 +167,8 @@ class Fbar {
     return stores_[set].shift.data();
   }
 
-  /// Particle i's L_bar (the header's equation); its own L where a volume ratio is not
-  /// positive (the step's stability check reports the inverted particle).
+  /// Particle i's L_bar (the header's equation); its own L where a volume ratio (1 + change)
+  /// is not positive (the step's stability check reports the inverted particle).
   void averaged_gradient(size_t set, size_t i, double dt, double (&l)[D][D]) const {
     const Store& s = stores_[set];
     const double* src = s.l.data() + i * size_t(D * D);
@@ -201,9 +201,11 @@ class Fbar {
   }
   static constexpr std::array<std::array<int, K>, K> kEntry = entries();
   struct Store {
-    std::vector<double> l, dj, dj_bar, mean, shift, tmp;  // D x D, then 1 each per particle
-    std::vector<size_t> corner;                           // the cell's lower corner (stored node)
-    std::vector<double> wv;                               // V_p N_I(x_p) of the K corners
+    // Per particle: L (D x D), the volume change det(I + L dt) - 1 and its projection, the
+    // mean normal stress and its projection's shift.
+    std::vector<double> l, dj, dj_bar, mean, shift;
+    std::vector<size_t> corner;  // the cell's lower corner (stored node)
+    std::vector<double> wv;      // V_p N_I(x_p) of the K corners
   };
 
   void locate_set(const Simulation<D>& sim, size_t set) {
