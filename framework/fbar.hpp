@@ -307,13 +307,11 @@ class Fbar {
 
   /// nodal_ ~ M^-1 rhs_ by kProducts conjugate-gradient steps preconditioned with the lumped
   /// mass W (the row sums of M), from the lumped solution rhs_ / W. W^-1 M is row-stochastic,
-  /// its spectrum in (0, 1] and about [1/2^D, 1] where cells are full; conjugate gradients
-  /// also resolve the few small eigenvalues of nodes that a partly filled cell's particles
-  /// hardly see, which a fixed polynomial (Chebyshev) left unconverged. The count is fixed: a
-  /// stopping test on the residual flips its count with round-off, and a run on ranks then left
-  /// the serial one by far more than round-off (1e-8 against 5e-13 in kinetic energy); with a
-  /// fixed count the result is continuous in its data. 20 steps: with 12 a rigid spin's
-  /// face error still reached 12 cells into the block above 1e-9 of E omega dt.
+  /// its spectrum in (0, 1] and about [1/2^D, 1] where cells are full; conjugate gradients also
+  /// resolve the few small eigenvalues of nodes that a partly filled cell's particles hardly
+  /// see. The count is fixed so that the result is continuous in its data: a stopping test on
+  /// the residual flips its count with round-off, and a run on ranks would then leave the
+  /// serial one by the solve's tolerance instead of round-off (docs/volumetric_locking.md).
   void solve_consistent_mass(Simulation<D>& sim) {
     const double* W = at(weights_);
     const double* b = at(rhs_);
@@ -330,7 +328,6 @@ class Fbar {
       p[k] = r[k] / W[k];
     }
     double rz = dot(sim, r, p);
-
     for (int it = 0; it < kProducts; ++it) {
       apply_mass(sim, p, q);
       const double pq = dot(sim, p, q);
