@@ -15,12 +15,19 @@ struct NodeForces {
   int stride;
 };
 
+/// The momentum balances a two-phase scheme hands to a damping: the skeleton's (or the
+/// mixture's) only, or the liquid's as well.
+enum class DampedPhases { solid, solid_and_liquid };
+
 template <int D>
 class Damping {
  public:
   static constexpr const char* kind = "damping";
   virtual ~Damping() = default;
   virtual void apply(Simulation<D>&, const NodeForces&) = 0;
+  /// Default: the solid only. Damping the liquid too brings water to rest (a settle stage), but
+  /// it would slow steady seepage, where the water's force balances the drag.
+  virtual DampedPhases phases() const { return DampedPhases::solid; }
   /// Whether it runs on a grid split over MPI ranks (docs/parallel.md): it reads and writes only
   /// the particles of this rank and the stored box of nodes, each node as the whole grid's
   /// value. Default false: a run under mpirun refuses it with a located error.

@@ -85,7 +85,8 @@ class Reactions {
           const double da = ph.acceleration.at(n, d) - before_[(j * 2 + size_t(k)) * D + size_t(d)];
           r[d] += ph.mass.at(n, 0) * da;
           const bool held = u.held[size_t(k)] && u.held[size_t(k)]->held(n, d);
-          if (k == 0 && damped_ && held && da != 0) r[d] += damping_[n * D + size_t(d)];
+          if (damped_[k] && held && da != 0)
+            r[d] += damping_[(size_t(k) * owner_.size() + n) * D + size_t(d)];
         }
       }
   }
@@ -126,11 +127,13 @@ class Reactions {
     if (it != entries_.end()) add_to_slot(it->second.slot, force);
   }
 
-  /// Local damping acts on the nodal forces of phase 0 (the only phase or the skeleton): the
-  /// forces at every reporting node before it, then after it (their difference is the
-  /// damping's force, left out of the reactions where a condition holds the component).
-  void before_damping(const NodalVector& force, const Grid<D>& grid, const Ranks<D>& ranks) {
-    if (damping_.size() != grid.num_nodes * D) damping_.assign(grid.num_nodes * D, 0.0);
+  /// Local damping acts on the nodal forces of a phase (0: the only phase, the skeleton or the
+  /// mixture; 1: the liquid, where the damping damps it too): the forces at every reporting node
+  /// before it, then after it (their difference is the damping's force, left out of the
+  /// reactions where a condition holds the component).
+  void before_damping(const NodalVector& force, const Grid<D>& grid, const Ranks<D>& ranks,
+                      int phase) {
+    if (damping_.size() != 2 * grid.num_nodes * D) damping_.assign(2 * grid.num_nodes * D, 0.0);
     if (owner_.size() != grid.num_nodes) owner_.assign(grid.num_nodes, -1);
     damped_nodes_.clear();
     for (auto& [b, e] : entries_) {
@@ -138,21 +141,23 @@ class Reactions {
       for (size_t n : e.nodes)
         if (owner_[n] != -2) owner_[n] = -2, damped_nodes_.push_back(n);  // each node once
     }
+    double* damping = damping_.data() + size_t(phase) * grid.num_nodes * D;
     for (size_t n : damped_nodes_) {
       owner_[n] = -1;
-      for (int d = 0; d < D; ++d) damping_[n * D + size_t(d)] = -force.at(n, d);
+      for (int d = 0; d < D; ++d) damping[n * D + size_t(d)] = -force.at(n, d);
     }
   }
-  void after_damping(const NodalVector& force) {
+  void after_damping(const NodalVector& force, const Grid<D>& grid, int phase) {
+    double* damping = damping_.data() + size_t(phase) * grid.num_nodes * D;
     for (size_t n : damped_nodes_)
-      for (int d = 0; d < D; ++d) damping_[n * D + size_t(d)] += force.at(n, d);
-    damped_ = true;
+      for (int d = 0; d < D; ++d) damping[n * D + size_t(d)] += force.at(n, d);
+    damped_[phase] = true;
   }
 
   /// A new step: no force yet.
   void begin_step() {
     std::fill(step_.begin(), step_.end(), 0.0);
-    damped_ = false;
+    damped_[0] = damped_[1] = false;
   }
   /// The step's forces complete over the ranks, and the extremes of the run so far.
   void end_step(const Ranks<D>& ranks) {
@@ -208,9 +213,9 @@ class Reactions {
   std::vector<int> owner_;       // per grid node: the column it is credited to this step, or -1
   std::vector<size_t> claimed_;  // the nodes credited this step
   std::vector<double>
-      damping_;  // per grid node and component: the damping's force (reporting nodes)
+      damping_;  // per phase, grid node and component: the damping's force (reporting nodes)
   std::vector<size_t> damped_nodes_;  // the reporting nodes, each once, where damping_ is set
-  bool damped_ = false;               // damping acted in this step
+  bool damped_[2] = {false, false};   // damping acted on the phase in this step
 };
 
 }  // namespace loam

@@ -33,8 +33,9 @@
 //      is split between the phases without differentiating n (the nodal n times the weak form of
 //      div sigma_w, as the single-point scheme does for -n grad p). Loads, the face forces of
 //      boundary conditions (on the mixture F_s + F_w and the water F_w) and local damping (on the
-//      solid) come in; then per node and component the momentum equations of the two phases with
-//      the drag implicit (solve_drag_implicit, framework/two_phase_blocks.hpp):
+//      solid; on the water too with `liquid: true`) come in; then per node and component the
+//      momentum equations of the two phases with the drag implicit (solve_drag_implicit,
+//      framework/two_phase_blocks.hpp):
 //        (m_w/dt + Q) w' - Q v' = m_w w/dt + F_w,   -Q w' + (m_s/dt + Q) v' = m_s v/dt + F_s.
 //      Drag acts only where both phases are present (Q comes from solid points, and a node
 //      without water mass takes no water velocity). A node with one phase integrates it alone.
@@ -771,7 +772,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     porosity_and_liquid_stress(sim);
     sim.apply_grid_loads(NodalVector{node_.data(), S, kF});
     boundary_forces(sim);
-    damp_solid(sim);
+    damp_phases(sim);
     solve_coupled(sim, dt);
     constrain_two_phase_update<D>(sim, node_.data(), kRecord, solved_.data(), dt);
   }
@@ -810,11 +811,17 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   }
 
   /// Local damping (damping:) acts on the solid's momentum balance; the water is damped by the
-  /// drag and its viscosity (damping its force would slow steady seepage).
-  void damp_solid(Simulation<D>& sim) {
+  /// drag and its viscosity (damping its force would slow steady seepage), and by the damping
+  /// too where it says so (a settle stage: water at rest at a free surface that B-splines
+  /// integrate inexactly reaches the discrete equilibrium, docs/verification.md F).
+  void damp_phases(Simulation<D>& sim) {
     if (!sim.damping) return;
     sim.apply_damping(NodeForces{node_.data() + kMs, NodalVector{node_.data(), S, kV},
                                  NodalVector{node_.data(), S, kF}, sim.grid.num_nodes, S});
+    if (sim.damping->phases() == DampedPhases::solid_and_liquid)
+      sim.apply_damping(NodeForces{node_.data() + kMw, NodalVector{node_.data(), S, kW},
+                                   NodalVector{node_.data(), S, kFw}, sim.grid.num_nodes, S},
+                        nullptr, kLiquid);
   }
 
   /// Per node and component the two momentum equations with the drag implicit; a node with one

@@ -295,6 +295,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   std::vector<double> solved_;  // per node: v', w' of the coupled solve (2 D values)
   std::vector<double> move_;    // MUSL: per particle, dt v_grid from the re-map pass (D values)
   std::vector<double> mixture_momentum_;  // per node (D values), once damping is on
+  std::vector<double> water_force_;       // per node (D values), once the water is damped
   // Pore-pressure increments of the step and, per grid cell, the volume-weighted sum of the
   // updated pressures and the volume (pressure_smoothing: cell).
   std::vector<double> dp_;
@@ -510,6 +511,22 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     });
     sim.apply_damping(NodeForces{node_.data() + kMs, NodalVector{mixture_momentum_.data(), D, 0},
                                  NodalVector{node_.data(), S, kF}, sim.grid.num_nodes, S});
+    if (sim.damping->phases() == DampedPhases::solid_and_liquid) damp_water(sim);
+  }
+  /// With `liquid: true` the water's own balance too (a settle stage): its force F_w against
+  /// its momentum m_w w; the mixture's force F takes the same change, so the skeleton's
+  /// F - F_w keeps its own.
+  void damp_water(Simulation<D>& sim) {
+    water_force_.resize(sim.grid.num_nodes * D);
+    for_each_record(sim, [&](const double* r, size_t i) {
+      for (int d = 0; d < D; ++d) water_force_[i * D + size_t(d)] = r[kFw + d];
+    });
+    sim.apply_damping(NodeForces{node_.data() + kMw, NodalVector{node_.data(), S, kW},
+                                 NodalVector{node_.data(), S, kFw}, sim.grid.num_nodes, S},
+                      nullptr, 1);
+    for_each_record(sim, [&](double* r, size_t i) {
+      for (int d = 0; d < D; ++d) r[kF + d] += r[kFw + d] - water_force_[i * D + size_t(d)];
+    });
   }
 
   /// Per node and component, the water and mixture momentum equations with the drag implicit:

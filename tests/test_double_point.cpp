@@ -967,14 +967,19 @@ std::string hydrostatic_column(int dim, const std::string& shape) {
 }
 
 /// The largest particle speed component of every set over each of `windows` equal parts of
-/// [0, end].
+/// [settle, settle + end], after `settle` seconds under the run's damping, which then stops.
 template <int D>
-std::vector<double> largest_speeds(const std::string& yaml, double end, int windows) {
+std::vector<double> largest_speeds(const std::string& yaml, double end, int windows,
+                                   double settle = 0) {
   auto sim = loam_test::make_simulation<D>(yaml);
+  while (sim->time < settle - 1e-12)
+    if (!sim->advance(std::min(sim->stable_dt(), settle - sim->time))) FAIL(sim->failure);
+  sim->damping.reset();
+  const double start = sim->time;
   std::vector<double> vmax(size_t(windows), 0.0);
-  while (sim->time < end - 1e-12) {
-    if (!sim->advance(std::min(sim->stable_dt(), end - sim->time))) FAIL(sim->failure);
-    const size_t w = std::min(size_t(windows) - 1, size_t(sim->time / end * windows));
+  while (sim->time - start < end - 1e-12) {
+    if (!sim->advance(std::min(sim->stable_dt(), end - (sim->time - start)))) FAIL(sim->failure);
+    const size_t w = std::min(size_t(windows) - 1, size_t((sim->time - start) / end * windows));
     for (const auto& set : sim->sets)
       for (int d = 0; d < D; ++d)
         for (size_t i = 0; i < set.size(); ++i)
@@ -995,28 +1000,52 @@ TEST_CASE(
   // projection keeps a linear water density per cell for bspline2 (framework/cell_projection.hpp):
   // with one constant per cell the top node of its water column had no equilibrium, and the
   // water accelerated without bound (0.12 m/s at 1 s in 1D). B-splines cut by a free surface
-  // inside the grid are still integrated inexactly by the points (docs/verification.md F): the
-  // hydrostatic start is then off the discrete equilibrium, and the points oscillate about it at
-  // a bounded speed, which must not grow: the largest speed of the second half of the run at
-  // most 1.5 times that of the first, and below 1e-3 m/s (measured 6.8e-4 to 7.0e-4 m/s, the
-  // largest over every step; a start in discrete equilibrium would remove it, not done).
+  // inside the grid are still integrated inexactly by the points, so the hydrostatic start is
+  // off the discrete equilibrium: started there the points oscillate about it at up to 7e-4 m/s
+  // (printed, and held below 1e-3 m/s and not growing). In 1D a settle of 1 s under local
+  // damping of both phases (`liquid: true`) reaches that equilibrium, and the undamped second
+  // of the run after it must meet the target. In 2D and 3D the settle is slower and still falls
+  // short (docs/verification.md F: the boundary-modified B-splines' nodal volume at the slip
+  // walls is off the points' quadrature, which drives seepage along the walls).
   for (const char* shape : {"linear", "gimp", "cpdi", "bspline2"}) {
     for (int dim : {1, 2, 3}) {
       const double end = dim == 1 ? 1.0 : 0.3;
       const std::string yaml = hydrostatic_column(dim, shape);
-      const auto v = dim == 1   ? largest_speeds<1>(yaml, end, 2)
-                     : dim == 2 ? largest_speeds<2>(yaml, end, 2)
-                                : largest_speeds<3>(yaml, end, 2);
-      std::printf(
-          "hydrostatic double point %dD %-8s: max |v| %.2e m/s (first half), %.2e m/s "
-          "(second half)\n",
-          dim, shape, v[0], v[1]);
-      if (std::string(shape) == "bspline2") {
+      const auto speeds = [&](const std::string& y, double settle) {
+        return dim == 1   ? largest_speeds<1>(y, end, 2, settle)
+               : dim == 2 ? largest_speeds<2>(y, end, 2, settle)
+                          : largest_speeds<3>(y, end, 2, settle);
+      };
+      const bool bspline = std::string(shape) == "bspline2";
+      const bool settle = bspline && dim == 1;
+      if (bspline) {
+        const auto v = speeds(yaml, 0);
+        std::printf(
+            "hydrostatic double point %dD %-8s started hydrostatic: max |v| %.2e m/s (first "
+            "half), %.2e m/s (second half)\n",
+            dim, shape, v[0], v[1]);
         CHECK(v[1] <= 1.5 * v[0]);
         CHECK(std::max(v[0], v[1]) <= 1e-3);
-      } else {
-        CHECK(std::max(v[0], v[1]) <= 1e-6);
       }
+      if (settle) {
+        // The skeleton's damping alone leaves the free water ringing (measured 6e-5 m/s after
+        // 5 s of it): the liquid's balance must be damped too.
+        const auto v = speeds(yaml + "damping: {type: local, alpha: 0.7}\n", end);
+        std::printf(
+            "hydrostatic double point %dD %-8s after a settle damping the solid only: max |v| "
+            "%.2e m/s\n",
+            dim, shape, std::max(v[0], v[1]));
+        CHECK(std::max(v[0], v[1]) > 1e-5);
+      }
+      if (bspline && !settle) continue;
+      const auto v = settle
+                         ? speeds(yaml + "damping: {type: local, alpha: 0.7, liquid: true}\n", end)
+                         : speeds(yaml, 0);
+      std::printf(
+          "hydrostatic double point %dD %-8s%s: max |v| %.2e m/s (first half), %.2e m/s "
+          "(second half)\n",
+          dim, shape, settle ? " after a damped settle" : "", v[0], v[1]);
+      CHECK(std::max(v[0], v[1]) <= 1e-6);
     }
   }
 }

@@ -79,17 +79,21 @@ TEST_CASE("reactions: the base of a two-phase column carries soil and water, bot
   // rho_s = 2650, rho_w = 1000 (configs/hydrostatic_column.yaml, single point); the double-point
   // column of configs/hydrostatic_double_point.yaml adds its free water above the soil. The sum
   // of the phases' reactions, mean over steps 200-400, within 0.1 %.
-  {
+  // Each also with both phases under local damping (`liquid: true`): the damping's force on a
+  // held component is no reaction, for the water as for the solid.
+  for (const std::string damping : {"", "damping: {type: local, alpha: 0.7, liquid: true}\n"}) {
+    INFO(damping);
     const std::string yaml = loam_test::slurp(std::filesystem::path(LOAM_SOURCE_DIR) / "configs" /
-                                              "hydrostatic_column.yaml");
+                                              "hydrostatic_column.yaml") +
+                             damping;
     auto sim = loam_test::make_simulation<1>(yaml);
     const double solid = mean_reaction(*sim, 0, 0, 200, 400);
     const double water = sim->reactions.force(0)[1];
     const double W = (0.6 * 2650 + 0.4 * 1000) * 9.81 * 1.0;
     std::printf(
-        "single point column: base reaction solid %.2f + water %.2f (last step) = %.2f N/m^2 "
+        "single point column%s: base reaction solid %.2f + water %.2f (last step) = %.2f N/m^2 "
         "against %.2f\n",
-        solid, water, solid + water, W);
+        damping.empty() ? "" : " (damped)", solid, water, solid + water, W);
     // The water's share is measured in the same steps: redo the mean of the sum.
     auto again = loam_test::make_simulation<1>(yaml);
     loam_test::advance(*again, 200);
@@ -98,13 +102,15 @@ TEST_CASE("reactions: the base of a two-phase column carries soil and water, bot
       loam_test::advance(*again, 1);
       sum += again->reactions.force(0)[0] + again->reactions.force(0)[1];
     }
-    std::printf("single point column: mean total base reaction %.2f N/m^2 (%+.4f %%)\n", sum / 200,
-                100 * (sum / 200 / W - 1));
+    std::printf("single point column%s: mean total base reaction %.2f N/m^2 (%+.4f %%)\n",
+                damping.empty() ? "" : " (damped)", sum / 200, 100 * (sum / 200 / W - 1));
     CHECK(std::fabs(sum / 200 / W - 1) <= 1e-3);
   }
-  {
+  for (const std::string damping : {"", "damping: {type: local, alpha: 0.7, liquid: true}\n"}) {
+    INFO(damping);
     const std::string yaml = loam_test::slurp(std::filesystem::path(LOAM_SOURCE_DIR) / "configs" /
-                                              "hydrostatic_double_point.yaml");
+                                              "hydrostatic_double_point.yaml") +
+                             damping;
     auto sim = loam_test::make_simulation<1>(yaml);
     double W = 0;
     for (const auto& set : sim->sets)
@@ -116,8 +122,8 @@ TEST_CASE("reactions: the base of a two-phase column carries soil and water, bot
       sum += sim->reactions.force(0)[0] + sim->reactions.force(0)[1];
     }
     std::printf(
-        "double point column: mean total base reaction %.2f N/m^2 against %.2f (%+.4f %%)\n",
-        sum / 200, W, 100 * (sum / 200 / W - 1));
+        "double point column%s: mean total base reaction %.2f N/m^2 against %.2f (%+.4f %%)\n",
+        damping.empty() ? "" : " (damped)", sum / 200, W, 100 * (sum / 200 / W - 1));
     CHECK(std::fabs(sum / 200 / W - 1) <= 1e-3);
   }
 }

@@ -20,9 +20,18 @@ class LocalDamping : public Damping<D> {
         .required()
         .min(0)
         .below(1);
+    s.boolean("liquid",
+              "also damp the liquid's momentum balance (two-phase schemes): a settle stage that "
+              "brings water to rest, e.g. at a free surface a B-spline grid integrates "
+              "inexactly (docs/verification.md F); leave it off where water should flow, it "
+              "slows seepage")
+        .def("false");
     return s;
   }
-  explicit LocalDamping(const Params& p) : alpha_(p.real("alpha")) {}
+  explicit LocalDamping(const Params& p)
+      : alpha_(p.real("alpha")),
+        phases_(p.flag("liquid") ? DampedPhases::solid_and_liquid : DampedPhases::solid) {}
+  DampedPhases phases() const override { return phases_; }
   /// Per node, on the stored box (docs/parallel.md).
   bool runs_on_ranks() const override { return true; }
   void apply(Simulation<D>& sim, const NodeForces& nf) override {
@@ -41,6 +50,7 @@ class LocalDamping : public Damping<D> {
 
  private:
   double alpha_;
+  DampedPhases phases_;
 };
 
 LOAM_REGISTER(Damping, LocalDamping)
