@@ -65,29 +65,6 @@ inline Volumetric volumetric_of(const Params& p) {
   return p.text("volumetric") == "fbar" ? Volumetric::kFbar : Volumetric::kNone;
 }
 
-/// det(I + A) - 1 with A = L dt, without the cancellation of det(I + A) - 1 in floating point:
-/// tr A + the sum of A's principal 2 x 2 minors + det A. F-bar projects this change rather than
-/// the ratio itself: the solve's round-off then scales with the change, and a rigid spin (a
-/// change of (omega dt)^2) stays free of stress.
-template <int D>
-double volume_change(const double (&l)[D][D], double dt) {
-  double a[D][D];
-  for (int i = 0; i < D; ++i)
-    for (int j = 0; j < D; ++j) a[i][j] = l[i][j] * dt;
-  if constexpr (D == 1) {
-    return a[0][0];
-  } else if constexpr (D == 2) {
-    return a[0][0] + a[1][1] + (a[0][0] * a[1][1] - a[0][1] * a[1][0]);
-  } else {
-    const double minors = a[0][0] * a[1][1] - a[0][1] * a[1][0] + a[0][0] * a[2][2] -
-                          a[0][2] * a[2][0] + a[1][1] * a[2][2] - a[1][2] * a[2][1];
-    const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
-                       a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                       a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-    return a[0][0] + a[1][1] + a[2][2] + minors + det;
-  }
-}
-
 template <int D>
 class Fbar {
  public:
@@ -275,19 +252,37 @@ class Fbar {
   /// periodic condition joins their masses and momenta the same way): each pair's sums go to
   /// both.
   void join_periodic(const Simulation<D>& sim, double* nodal) {
-    if (periodic_pairs_.empty())
-      for (int a = 0; a < D; ++a)
-        if (sim.held_faces.period[size_t(a)] > 0) {
-          const auto lo = face_nodes(sim.grid, Face{a, false});
-          const auto hi = face_nodes(sim.grid, Face{a, true});
-          for (size_t k = 0; k < lo.size(); ++k) periodic_pairs_.push_back({lo[k], hi[k]});
-        }
     const size_t nodes = sim.grid.num_nodes;
     for (int g = 0; g < groups_; ++g)
-      for (const auto& [lo, hi] : periodic_pairs_) {
+      for (const auto& [lo, hi] : periodic_pairs(sim)) {
         double* n = nodal + size_t(g) * nodes;
         n[lo] = n[hi] = n[lo] + n[hi];
       }
+  }
+
+  /// The node pairs that periodic faces join (lower face, upper face); built on first use.
+  const std::vector<std::pair<size_t, size_t>>& periodic_pairs(const Simulation<D>& sim) {
+    if (periodic_pairs_built_) return periodic_pairs_;
+    for (int a = 0; a < D; ++a)
+      if (sim.held_faces.period[size_t(a)] > 0) {
+        const auto lo = face_nodes(sim.grid, Face{a, false});
+        const auto hi = face_nodes(sim.grid, Face{a, true});
+        for (size_t k = 0; k < lo.size(); ++k) periodic_pairs_.push_back({lo[k], hi[k]});
+      }
+    periodic_pairs_built_ = true;
+    return periodic_pairs_;
+  }
+  /// Per node, whether dot() counts it: this rank's own, and of a periodic pair the lower
+  /// node only. Fixed for the run (the ranks' cut does not move); built on first use.
+  const std::vector<uint8_t>& counted_nodes(const Simulation<D>& sim) {
+    const size_t nodes = sim.grid.num_nodes;
+    if (counts_.size() == nodes) return counts_;
+    counts_.assign(nodes, 1);
+    for (const auto& pr : periodic_pairs(sim)) counts_[pr.second] = 0;
+    if (sim.ranks->distributed())
+      for (size_t n = 0; n < nodes; ++n)
+        if (!sim.ranks->owns_node(sim.grid, sim.grid.node_ijk(n))) counts_[n] = 0;
+    return counts_;
   }
 
   /// (s.*out)[i] = (s.*in)[i] projected onto the continuous (bi/tri)linear nodal field of its
@@ -411,18 +406,14 @@ class Fbar {
   /// own, a periodic pair once), and the solve's vectors sized with pad_ zeros on both sides.
   void index_nodes(const Simulation<D>& sim) {
     const size_t nodes = sim.grid.num_nodes, n_all = size_t(groups_) * nodes;
-    std::vector<uint8_t> partner(nodes, 0);
-    for (const auto& pr : periodic_pairs_) partner[pr.second] = 1;
+    const std::vector<uint8_t>& counts = counted_nodes(sim);
     active_.clear();
     counted_.clear();
     const double* W = at(weights_);
     for (size_t k = 0; k < n_all; ++k) {
       if (!(W[k] > 0)) continue;
       active_.push_back(k);
-      const size_t node = k % nodes;
-      if (!partner[node] &&
-          (!sim.ranks->distributed() || sim.ranks->owns_node(sim.grid, sim.grid.node_ijk(node))))
-        counted_.push_back(k);
+      if (counts[k % nodes]) counted_.push_back(k);
     }
     for (auto* v : {&rhs_, &nodal_, &res_, &dir_, &pre_, &prod_}) v->assign(n_all + 2 * pad_, 0.0);
   }
@@ -495,7 +486,9 @@ class Fbar {
   std::vector<size_t> active_, counted_;  // group-major node indices: the solve's, dot()'s
   std::vector<double> chunk_sums_;        // dot()
   size_t pad_ = 0;                        // zeros before and after the solve's nodal vectors
-  std::vector<std::pair<size_t, size_t>> periodic_pairs_;  // join_periodic
+  std::vector<std::pair<size_t, size_t>> periodic_pairs_;  // periodic_pairs()
+  bool periodic_pairs_built_ = false;
+  std::vector<uint8_t> counts_;  // per node: counted_nodes()
 };
 
 }  // namespace loam

@@ -99,6 +99,30 @@ LOAM_FORCE_INLINE double det_increment(const double (&l)[D][D], double dt) {
   }
 }
 
+/// det(I + A) - 1 with A = L dt, without the cancellation of det(I + A) - 1 in floating point:
+/// tr A + the sum of A's principal 2 x 2 minors + det A: the volume change det_increment - 1
+/// of a step where it is small against 1 (F-bar, framework/fbar.hpp, projects it: the
+/// projection's round-off then scales with the change, and a rigid spin, a change of
+/// (omega dt)^2, stays free of stress).
+template <int D>
+double volume_change(const double (&l)[D][D], double dt) {
+  double a[D][D];
+  for (int i = 0; i < D; ++i)
+    for (int j = 0; j < D; ++j) a[i][j] = l[i][j] * dt;
+  if constexpr (D == 1) {
+    return a[0][0];
+  } else if constexpr (D == 2) {
+    return a[0][0] + a[1][1] + (a[0][0] * a[1][1] - a[0][1] * a[1][0]);
+  } else {
+    const double minors = a[0][0] * a[1][1] - a[0][1] * a[1][0] + a[0][0] * a[2][2] -
+                          a[0][2] * a[2][0] + a[1][1] * a[2][2] - a[1][2] * a[2][1];
+    const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+                       a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                       a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    return a[0][0] + a[1][1] + a[2][2] + minors + det;
+  }
+}
+
 /// F^{n+1} = (I + L dt) F^n for particle p of a block; F holds the D*D component columns
 /// (F_ij at index i*D + j) at the block start.
 template <int D>
