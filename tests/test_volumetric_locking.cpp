@@ -1,6 +1,7 @@
 // Volumetric locking and its treatment, `scheme.volumetric: fbar` (framework/fbar.hpp,
 // docs/volumetric_locking.md): the collapse load of nearly incompressible plastic flow must not
 // depend on Poisson's ratio, and the energy balance must still close.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
@@ -202,4 +203,46 @@ TEST_CASE(
         shape.c_str(), diff, diff / (g * dt), largest);
     CHECK(diff <= 1e-6 * g * dt);
   }
+}
+
+TEST_CASE("bearing_capacity: the mean of -R / b over the window, and its bad input located",
+          "[locking][reference][bad_config]") {
+  // plugins/references/bearing_capacity.cpp: q = -R_y / b averaged over the steps whose time is
+  // in the window must be the same mean taken from history.csv's reaction column (every step,
+  // 17 digits), to round-off; bearing_error = q / (N_c s_u) - 1.
+  loam_test::TempDir dir("bearing");
+  std::string yaml = footing("linear", "fbar", 0.49);
+  yaml.replace(yaml.find("time: {end: 2.5}"), 16, "time: {end: 1.0}");
+  yaml.replace(yaml.find("history_every: 5"), 16, "history_every: 1");
+  const std::string verify =
+      "verify: {type: bearing_capacity, reaction: footing, width: 0.5, undrained_strength: "
+      "1.0e4, bearing_factor: 5.219, window: [0.5, 1.0]}\n";
+  const auto r = loam_test::run_yaml(dir.path, yaml + verify, "--threads 1");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  const auto h = loam_test::read_csv_columns(dir.path / "out" / "history.csv");
+  double sum = 0;
+  int n = 0;
+  for (size_t i = 0; i < h.at("time").size(); ++i)
+    if (h.at("time")[i] >= 0.5 && h.at("time")[i] <= 1.0)
+      sum += -h.at("reaction_footing_y")[i] / 0.5, ++n;
+  const auto s =
+      nlohmann::json::parse(loam_test::slurp(dir.path / "out" / "summary.json"))["verify"];
+  const double q = s["bearing_pressure"];
+  std::printf(
+      "bearing_capacity: q %.6g Pa over %d steps (history: %.6g), q / s_u %.4f, error %+.4f\n", q,
+      n, sum / n, s["bearing_ratio"].get<double>(), s["bearing_error"].get<double>());
+  CHECK(s["bearing_samples"].get<double>() == n);
+  CHECK(q == Approx(sum / n).epsilon(1e-12));
+  CHECK(s["bearing_error"].get<double>() == Approx(q / (5.219e4) - 1).epsilon(1e-12));
+  // An unknown reaction and a reversed window: located errors, nothing written.
+  const std::string base = yaml + "verify: {type: bearing_capacity, reaction: ";
+  const std::string line = std::to_string(std::count(yaml.begin(), yaml.end(), '\n') + 1);
+  loam_test::check_located_error(
+      dir.path, base + "pusher, width: 0.5, undrained_strength: 1.0e4, window: [0.5, 1.0]}\n",
+      "run.yaml:" + line + ":",
+      "no reaction named 'pusher' (the conditions' reactions: footing, slip_x-");
+  loam_test::check_located_error(
+      dir.path, base + "footing, width: 0.5, undrained_strength: 1.0e4, window: [1.0, 0.5]}\n",
+      "run.yaml:" + line + ":", "give [t0, t1] with 0 <= t0 < t1");
 }

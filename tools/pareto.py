@@ -48,14 +48,18 @@ def main():
     if not metric or metric not in rows[0]:
         sys.exit("no error metric column (use --metric)")
     series = a.series if a.series in rows[0] else None
-    pts = []
+    pts, left_out = [], []
     for r in rows:
         try:
-            t, e = float(r["wall_seconds"]), float(r[metric])
+            t, e = float(r["wall_seconds"]), abs(float(r[metric]))  # a signed error's size
         except (ValueError, KeyError):
-            continue  # failed variants have no numbers
+            t, e = 0.0, float("nan")  # failed variants have no numbers
         if r["status"] == "ok" and t > 0 and e > 0 and math.isfinite(e):
             pts.append((t, e, r[series] if series else "all", r["variant"]))
+        else:
+            left_out.append(f"{r['variant']} ({r['status']}, {metric} {r.get(metric) or '-'})")
+    if left_out:
+        print("not plotted: " + "; ".join(left_out), file=sys.stderr)
     if not pts:
         sys.exit("no successful variant with a positive error")
     fig, ax = plt.subplots(figsize=(7, 5))
@@ -76,7 +80,7 @@ def main():
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("wall time per run (s)")
-    ax.set_ylabel(metric)
+    ax.set_ylabel(f"|{metric}|")
     ax.set_title("speed against error" + (f" by {series}" if series else ""))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
