@@ -19,6 +19,10 @@ struct NodeForces {
 /// mixture's) only, or the liquid's as well.
 enum class DampedPhases { solid, solid_and_liquid };
 
+/// The momentum balance a damping acts on, in the grid update's phase order: the only phase, the
+/// skeleton or the mixture; a two-phase scheme's liquid.
+enum class MomentumBalance { kSolid = 0, kLiquid = 1 };
+
 template <int D>
 class Damping {
  public:

@@ -85,8 +85,7 @@ class Reactions {
           const double da = ph.acceleration.at(n, d) - before_[(j * 2 + size_t(k)) * D + size_t(d)];
           r[d] += ph.mass.at(n, 0) * da;
           const bool held = u.held[size_t(k)] && u.held[size_t(k)]->held(n, d);
-          if (damped_[k] && held && da != 0)
-            r[d] += damping_[(size_t(k) * owner_.size() + n) * D + size_t(d)];
+          if (damped_[k] && held && da != 0) r[d] += damping_of(k)[n * D + size_t(d)];
         }
       }
   }
@@ -127,12 +126,12 @@ class Reactions {
     if (it != entries_.end()) add_to_slot(it->second.slot, force);
   }
 
-  /// Local damping acts on the nodal forces of a phase (0: the only phase, the skeleton or the
-  /// mixture; 1: the liquid, where the damping damps it too): the forces at every reporting node
-  /// before it, then after it (their difference is the damping's force, left out of the
-  /// reactions where a condition holds the component).
+  /// Local damping acts on the nodal forces of a momentum balance (the liquid's too where the
+  /// damping damps it): the forces at every reporting node before it, then after it (their
+  /// difference is the damping's force, left out of the reactions where a condition holds the
+  /// component).
   void before_damping(const NodalVector& force, const Grid<D>& grid, const Ranks<D>& ranks,
-                      int phase) {
+                      MomentumBalance balance) {
     if (damping_.size() != 2 * grid.num_nodes * D) damping_.assign(2 * grid.num_nodes * D, 0.0);
     if (owner_.size() != grid.num_nodes) owner_.assign(grid.num_nodes, -1);
     damped_nodes_.clear();
@@ -141,17 +140,17 @@ class Reactions {
       for (size_t n : e.nodes)
         if (owner_[n] != -2) owner_[n] = -2, damped_nodes_.push_back(n);  // each node once
     }
-    double* damping = damping_.data() + size_t(phase) * grid.num_nodes * D;
+    double* damping = damping_of(int(balance));
     for (size_t n : damped_nodes_) {
       owner_[n] = -1;
       for (int d = 0; d < D; ++d) damping[n * D + size_t(d)] = -force.at(n, d);
     }
   }
-  void after_damping(const NodalVector& force, const Grid<D>& grid, int phase) {
-    double* damping = damping_.data() + size_t(phase) * grid.num_nodes * D;
+  void after_damping(const NodalVector& force, MomentumBalance balance) {
+    double* damping = damping_of(int(balance));
     for (size_t n : damped_nodes_)
       for (int d = 0; d < D; ++d) damping[n * D + size_t(d)] += force.at(n, d);
-    damped_[phase] = true;
+    damped_[int(balance)] = true;
   }
 
   /// A new step: no force yet.
@@ -216,6 +215,9 @@ class Reactions {
       damping_;  // per phase, grid node and component: the damping's force (reporting nodes)
   std::vector<size_t> damped_nodes_;  // the reporting nodes, each once, where damping_ is set
   bool damped_[2] = {false, false};   // damping acted on the phase in this step
+
+  /// Phase k's part of damping_ (each phase has half of it).
+  double* damping_of(int k) { return damping_.data() + size_t(k) * (damping_.size() / 2); }
 };
 
 }  // namespace loam

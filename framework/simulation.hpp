@@ -256,11 +256,10 @@ class Simulation {
   /// under contact holds another body up, ContactFields::supported_nodes) keep theirs: the
   /// support is not in their force, so damping it would carry part of the load (a block
   /// resting on a rigid plate under local damping alpha = 0.3 put 30 % less on the plate).
-  /// `phase`: 0 the only phase, the skeleton or the mixture; 1 a two-phase scheme's liquid.
   void apply_damping(const NodeForces& nf, const std::vector<size_t>* supported = nullptr,
-                     int phase = 0) {
+                     MomentumBalance balance = MomentumBalance::kSolid) {
     if (!damping) return;
-    if (!reactions.empty()) reactions.before_damping(nf.force, grid, *ranks, phase);
+    if (!reactions.empty()) reactions.before_damping(nf.force, grid, *ranks, balance);
     const auto act = [&] {
       if (!supported || supported->empty()) return damping->apply(*this, nf);
       std::vector<double> kept;
@@ -270,13 +269,13 @@ class Simulation {
       for (size_t k = 0; k < supported->size(); ++k)
         for (int d = 0; d < D; ++d) nf.force.at((*supported)[k], d) = kept[k * D + size_t(d)];
     };
-    // The ledger prices recorded forces at phase 0's velocities; the double-point liquid's work
-    // is outside the balance (docs/energy_balance.md), its damping with it.
-    if (phase == 0)
+    // The ledger prices recorded forces at the first phase's velocities; the double-point liquid's
+    // work is outside the balance (docs/energy_balance.md), its damping with it.
+    if (balance == MomentumBalance::kSolid)
       ledger.record(NodalWork::kDamping, nf.force, act);
     else
       act();
-    if (!reactions.empty()) reactions.after_damping(nf.force, grid, phase);
+    if (!reactions.empty()) reactions.after_damping(nf.force, balance);
   }
   /// f(set, begin, count, thread) over the blocks of every set: race-free scatters set after
   /// set (one grid), gathers on all threads.

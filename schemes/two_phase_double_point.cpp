@@ -821,7 +821,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     if (sim.damping->phases() == DampedPhases::solid_and_liquid)
       sim.apply_damping(NodeForces{node_.data() + kMw, NodalVector{node_.data(), S, kW},
                                    NodalVector{node_.data(), S, kFw}, sim.grid.num_nodes, S},
-                        nullptr, kLiquid);
+                        nullptr, MomentumBalance::kLiquid);
   }
 
   /// Per node and component the two momentum equations with the drag implicit; a node with one

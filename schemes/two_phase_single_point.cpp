@@ -523,7 +523,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     });
     sim.apply_damping(NodeForces{node_.data() + kMw, NodalVector{node_.data(), S, kW},
                                  NodalVector{node_.data(), S, kFw}, sim.grid.num_nodes, S},
-                      nullptr, 1);
+                      nullptr, MomentumBalance::kLiquid);
     for_each_record(sim, [&](double* r, size_t i) {
       for (int d = 0; d < D; ++d) r[kF + d] += r[kFw + d] - water_force_[i * D + size_t(d)];
     });

@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli.hpp"
@@ -635,171 +636,206 @@ std::vector<Scene> whole_run_scenes() {
   return scenes;
 }
 
-/// Each scene run serially and under mpirun at each of `rank_counts`: momentum and energies at
-/// every step within 1e-12 of the serial run (relative to each series' largest magnitude),
-/// particle fields after 200 steps within 1e-10 (relative to each field's largest magnitude),
-/// the same id set and count, -np 1 the serial run's bits, and (the columns) the same bits when
-/// repeated at the last rank count. The ranks add the ghost layer's shares in another order than
-/// the serial scatter, so they agree to round-off only.
+/// A scene's serial run in dir/serial: its history, frame numbers, mass and summary, and the
+/// largest energy of the run (the scale of the energies' differences).
+struct SerialRun {
+  fs::path dir;
+  std::map<std::string, std::vector<double>> history;
+  std::vector<long> frames;
+  double mass = 0, energy_scale = 0;
+  nlohmann::json summary;
+};
+SerialRun run_serially(const Scene& scene, const fs::path& dir) {
+  const auto r = run_on(dir, "serial", 0);
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  SerialRun s;
+  s.dir = dir / "serial";
+  s.history = loam_test::read_csv_columns(s.dir / "history.csv");
+  for (long f = 0; fs::exists(frame_file(s.dir, f, -1, scene.sets[0])); ++f) s.frames.push_back(f);
+  REQUIRE(s.frames.size() >= 5);
+  s.summary = nlohmann::json::parse(loam_test::slurp(s.dir / "summary.json"));
+  for (const auto& set : scene.sets) s.mass += s.summary["sets"][set]["mass"].get<double>();
+  for (const char* key : {"kinetic_energy", "strain_energy", "gravity_energy"})
+    for (double x : s.history.at(key)) s.energy_scale = std::max(s.energy_scale, std::fabs(x));
+  return s;
+}
+
+/// Momentum and energies at every step against the serial run's: energies relative to the
+/// largest energy of the run, momentum to sqrt(2 M E_kin) (the momentum of the whole mass at
+/// the rms speed), the particle count exactly (a difference of 1 exceeds the limit).
+double history_error(const SerialRun& serial, const fs::path& out) {
+  const auto& h0 = serial.history;
+  const auto h = loam_test::read_csv_columns(out / "history.csv");
+  REQUIRE(h.at("step") == h0.at("step"));
+  const double momentum_scale = std::sqrt(2 * serial.mass * serial.energy_scale);
+  double error = 0;
+  for (const auto& key : kHistory) {
+    if (!h0.count(key)) continue;
+    const auto& a = h0.at(key);
+    const auto& b = h.at(key);
+    const double scale = key == "time" || key == "particles" ? 1.0
+                         : key.rfind("mass_", 0) == 0        ? serial.mass
+                         : key.rfind("momentum", 0) == 0     ? momentum_scale
+                                                             : serial.energy_scale;
+    for (size_t i = 0; i < a.size(); ++i) error = std::max(error, std::fabs(a[i] - b[i]) / scale);
+  }
+  return error;
+}
+
+/// Particle fields, id sets and mass at every frame against the serial run's, and the
+/// particles held by another rank in some frame than at the start (the run crossed the cuts).
+struct FrameComparison {
+  double error = 0;
+  bool ids_match = true;
+  size_t moved = 0, particles = 0;
+};
+FrameComparison compare_frames(const Scene& scene, const SerialRun& serial, const fs::path& out,
+                               int ranks) {
+  Difference difference;
+  std::set<int> moved;
+  FrameComparison c;
+  for (const auto& set : scene.sets) {
+    std::map<int, int> last;  // id -> the rank that held it in the last frame it was in
+    for (long f : serial.frames) {
+      const Frame fr = read_frame(out, f, ranks, set);
+      if (f == serial.frames.front()) c.particles += fr.count;
+      difference.add(read_frame(serial.dir, f, 0, set), fr, set + ".");
+      for (const auto& [id, r] : fr.piece) {
+        if (last.count(id) && last.at(id) != r) moved.insert(id);
+        last[id] = r;
+      }
+    }
+  }
+  c.error = difference.relative();
+  c.ids_match = difference.ids_match;
+  c.moved = moved.size();
+  return c;
+}
+
+/// Probes (disks: two particles, one node; the staged columns: particles at the base and the
+/// toe): every step's row, each column relative to its largest magnitude; and the rows compared.
+std::pair<double, long> probe_error(const SerialRun& serial, const fs::path& out) {
+  double error = 0;
+  long rows = 0;
+  for (const char* probe : {"left_front", "right_front", "middle", "base", "base_2", "toe"}) {
+    const fs::path csv = fs::path("probe_") += std::string(probe) + ".csv";
+    if (!fs::exists(serial.dir / csv)) continue;
+    const auto p0 = loam_test::read_csv_columns(serial.dir / csv);
+    const auto p = loam_test::read_csv_columns(out / csv);
+    REQUIRE(p.at("step") == p0.at("step"));
+    for (const auto& [key, a] : p0) {
+      const auto& b = p.at(key);
+      double scale = 0;
+      for (double x : a) scale = std::max(scale, std::fabs(x));
+      for (size_t i = 0; i < a.size(); ++i)
+        error = std::max(error, std::fabs(a[i] - b[i]) / (scale > 0 ? scale : 1.0));
+    }
+    rows += long(p0.at("step").size());
+  }
+  return {error, rows};
+}
+
+/// summary.json on the ranks (written by the first rank) against the serial one: the whole
+/// model's counts and masses, the reference's metrics over the ranks, the final kinetic energy,
+/// each stage's status and steps, and the particles sources and sinks made and took.
+void check_summary(const Scene& scene, const SerialRun& serial, const fs::path& out, int ranks) {
+  const auto summary = nlohmann::json::parse(loam_test::slurp(out / "summary.json"));
+  const auto& summary0 = serial.summary;
+  CHECK(summary["particles"] == summary0["particles"]);
+  CHECK(summary["ranks"] == ranks);
+  for (const char* key : {"initial", "final", "created", "removed"})
+    CHECK(std::fabs(summary["mass"][key].get<double>() - summary0["mass"][key].get<double>()) <=
+          1e-12 * serial.mass);
+  for (const auto& [key, value] : summary0["verify"].items()) {
+    if (!value.is_number()) continue;
+    INFO("verify." << key);
+    const double a = value.get<double>(), b = summary["verify"][key].get<double>();
+    CHECK(std::fabs(a - b) <= 1e-10 * std::max(1.0, std::fabs(a)));
+  }
+  if (scene.name.find("column collapse") != std::string::npos)
+    CHECK(summary0["verify"].contains("runout"));
+  CHECK(std::fabs(summary["energy_final"]["kinetic"].get<double>() -
+                  summary0["energy_final"]["kinetic"].get<double>()) <=
+        1e-12 * serial.energy_scale);
+  if (summary0.contains("stages")) {
+    REQUIRE(summary["stages"].size() == summary0["stages"].size());
+    for (size_t k = 0; k < summary0["stages"].size(); ++k) {
+      const auto &st = summary["stages"][k], &st0 = summary0["stages"][k];
+      std::printf("  stage %zu '%s': %s after %ld steps (serial: %s after %ld)\n", k,
+                  st0["name"].get<std::string>().c_str(), st["status"].get<std::string>().c_str(),
+                  st["steps"].get<long>(), st0["status"].get<std::string>().c_str(),
+                  st0["steps"].get<long>());
+      CHECK(st["status"] == st0["status"]);
+      CHECK(st["steps"] == st0["steps"]);
+    }
+  }
+  CHECK(summary["particles_created"] == summary0["particles_created"]);
+  CHECK(summary["particles_removed"] == summary0["particles_removed"]);
+  if (scene.name.find("sink") != std::string::npos) {
+    std::printf("  created %s, removed %s particles\n", summary["particles_created"].dump().c_str(),
+                summary["particles_removed"].dump().c_str());
+    CHECK(summary0["particles_created"].get<long>() > 0);
+    CHECK(summary0["particles_removed"].get<long>() > 0);
+  }
+}
+
+/// The scene under mpirun -np `ranks` into dir/np<ranks> against its serial run: history
+/// within 1e-12, fields and probes within 1e-10, the same ids, -np 1 bitwise, the cuts crossed
+/// where the scene says so, and the summary (check_summary).
+void check_run_on_ranks(const Scene& scene, const SerialRun& serial, const fs::path& dir,
+                        int ranks) {
+  const std::string name = "np" + std::to_string(ranks);
+  const auto r = run_on(dir, name, ranks);
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  const fs::path out = dir / name;
+  const double history = history_error(serial, out);
+  const FrameComparison frames = compare_frames(scene, serial, out, ranks);
+  const auto [probes, probe_rows] = probe_error(serial, out);
+  check_summary(scene, serial, out, ranks);
+  const long last = serial.frames.back();
+  bool same_bits = true;
+  for (const auto& set : scene.sets)
+    same_bits = same_bits && frames_identical(read_frame(serial.dir, last, 0, set),
+                                              read_frame(out, last, ranks, set));
+  std::printf(
+      "mpi run, %-26s -np %d: history (momentum, energies) %.2e, particle fields %.2e over "
+      "%zu frames, probes %.2e over %ld rows, ids %s, %zu particles changed rank (%zu at the "
+      "start)%s\n",
+      scene.name.c_str(), ranks, history, frames.error, serial.frames.size(), probes, probe_rows,
+      frames.ids_match ? "match" : "DIFFER", frames.moved, frames.particles,
+      same_bits ? ", bitwise the serial run" : "");
+  CHECK(frames.ids_match);
+  CHECK(history <= 1e-12);
+  CHECK(frames.error <= 1e-10);
+  CHECK(probes <= 1e-10);
+  if (scene.name.find("disks") != std::string::npos) CHECK(probe_rows > 0);
+  if (ranks == 1) CHECK(same_bits);
+  if (scene.crosses > 0 && ranks >= scene.crosses) CHECK(frames.moved > 0);
+}
+
+/// Each scene run serially and under mpirun at each of `rank_counts` (check_run_on_ranks), and
+/// the columns repeated at the last rank count: the same bits (the neighbour order is fixed),
+/// once per shape function. The ranks add the ghost layer's shares in another order than the
+/// serial scatter, so they agree with it to round-off only.
 void check_whole_runs(const std::vector<int>& rank_counts) {
   for (const Scene& scene : whole_run_scenes()) {
     INFO(scene.name);
     TempDir dir("mpi_run");
     fs::create_directories(dir.path);
     std::ofstream(dir.path / "run.yaml") << scene.yaml;
-    const auto serial = run_on(dir.path, "serial", 0);
-    INFO(serial.output);
-    REQUIRE(serial.exit_code == 0);
-    const auto h0 = loam_test::read_csv_columns(dir.path / "serial" / "history.csv");
-    std::vector<long> frame_ids;
-    for (long f = 0; fs::exists(frame_file(dir.path / "serial", f, -1, scene.sets[0])); ++f)
-      frame_ids.push_back(f);
-    REQUIRE(frame_ids.size() >= 5);
-    double mass = 0;
-    for (const auto& set : scene.sets)
-      mass += nlohmann::json::parse(
-                  loam_test::slurp(dir.path / "serial" / "summary.json"))["sets"][set]["mass"]
-                  .get<double>();
-    for (int ranks : rank_counts) {
-      const std::string out = "np" + std::to_string(ranks);
-      const auto r = run_on(dir.path, out, ranks);
-      INFO(r.output);
-      REQUIRE(r.exit_code == 0);
-      // Momentum and energies at every step: energies relative to the largest energy of the
-      // run, momentum to sqrt(2 M E_kin) (the momentum of the whole mass at the rms speed).
-      const auto h = loam_test::read_csv_columns(dir.path / out / "history.csv");
-      REQUIRE(h.at("step") == h0.at("step"));
-      double energy_scale = 0;
-      for (const char* key : {"kinetic_energy", "strain_energy", "gravity_energy"})
-        for (double x : h0.at(key)) energy_scale = std::max(energy_scale, std::fabs(x));
-      const double momentum_scale = std::sqrt(2 * mass * energy_scale);
-      double history_error = 0;
-      for (const auto& key : kHistory) {
-        if (!h0.count(key)) continue;
-        const auto& a = h0.at(key);
-        const auto& b = h.at(key);
-        // The particle count exactly (a difference of 1 exceeds the limit).
-        const double scale = key == "time" || key == "particles" ? 1.0
-                             : key.rfind("mass_", 0) == 0        ? mass
-                             : key.rfind("momentum", 0) == 0     ? momentum_scale
-                                                                 : energy_scale;
-        for (size_t i = 0; i < a.size(); ++i)
-          history_error = std::max(history_error, std::fabs(a[i] - b[i]) / scale);
-      }
-      // Particle fields, id sets and mass at every frame; the last one after 200 (500) steps.
-      // The particles held by another rank in some frame than at the start: the run crossed
-      // the cuts.
-      Difference difference;
-      std::set<int> moved;
-      size_t particles = 0;
-      for (const auto& set : scene.sets) {
-        std::map<int, int> last;  // id -> the rank that held it in the last frame it was in
-        for (long f : frame_ids) {
-          const Frame fr = read_frame(dir.path / out, f, ranks, set);
-          if (f == frame_ids.front()) particles += fr.count;
-          difference.add(read_frame(dir.path / "serial", f, 0, set), fr, set + ".");
-          for (const auto& [id, r] : fr.piece) {
-            if (last.count(id) && last.at(id) != r) moved.insert(id);
-            last[id] = r;
-          }
-        }
-      }
-      const double field_error = difference.relative();
-      const bool ids_match = difference.ids_match;
-      // Probes (disks: two particles, one node; the staged columns: particles at the base and
-      // the toe): every step's row, each column within 1e-10
-      // of its largest magnitude, as the frames' fields.
-      double probe_error = 0;
-      long probe_rows = 0;
-      for (const char* probe : {"left_front", "right_front", "middle", "base", "base_2", "toe"}) {
-        const fs::path csv = fs::path("probe_") += std::string(probe) + ".csv";
-        if (!fs::exists(dir.path / "serial" / csv)) continue;
-        const auto p0 = loam_test::read_csv_columns(dir.path / "serial" / csv);
-        const auto p = loam_test::read_csv_columns(dir.path / out / csv);
-        REQUIRE(p.at("step") == p0.at("step"));
-        for (const auto& [key, a] : p0) {
-          const auto& b = p.at(key);
-          double scale = 0;
-          for (double x : a) scale = std::max(scale, std::fabs(x));
-          for (size_t i = 0; i < a.size(); ++i)
-            probe_error = std::max(probe_error, std::fabs(a[i] - b[i]) / (scale > 0 ? scale : 1.0));
-        }
-        probe_rows += long(p0.at("step").size());
-      }
-      // summary.json: the whole model's counts and masses, written by the first rank.
-      const auto summary = nlohmann::json::parse(loam_test::slurp(dir.path / out / "summary.json"));
-      const auto summary0 =
-          nlohmann::json::parse(loam_test::slurp(dir.path / "serial" / "summary.json"));
-      CHECK(summary["particles"] == summary0["particles"]);
-      CHECK(summary["ranks"] == ranks);
-      for (const char* key : {"initial", "final", "created", "removed"})
-        CHECK(std::fabs(summary["mass"][key].get<double>() - summary0["mass"][key].get<double>()) <=
-              1e-12 * mass);
-      // The reference's metrics (the columns: run-out, final height, largest speed), over
-      // the ranks.
-      for (const auto& [key, value] : summary0["verify"].items()) {
-        if (!value.is_number()) continue;
-        INFO("verify." << key);
-        const double a = value.get<double>(), b = summary["verify"][key].get<double>();
-        CHECK(std::fabs(a - b) <= 1e-10 * std::max(1.0, std::fabs(a)));
-      }
-      if (scene.name.find("column collapse") != std::string::npos)
-        CHECK(summary0["verify"].contains("runout"));
-      CHECK(std::fabs(summary["energy_final"]["kinetic"].get<double>() -
-                      summary0["energy_final"]["kinetic"].get<double>()) <= 1e-12 * energy_scale);
-      const long last = frame_ids.back();
-      bool same_bits = true;
-      for (const auto& set : scene.sets)
-        same_bits = same_bits && frames_identical(read_frame(dir.path / "serial", last, 0, set),
-                                                  read_frame(dir.path / out, last, ranks, set));
-      std::printf(
-          "mpi run, %-26s -np %d: history (momentum, energies) %.2e, particle fields %.2e over "
-          "%zu frames, probes %.2e over %ld rows, ids %s, %zu particles changed rank (%zu at the "
-          "start)%s\n",
-          scene.name.c_str(), ranks, history_error, field_error, frame_ids.size(), probe_error,
-          probe_rows, ids_match ? "match" : "DIFFER", moved.size(), particles,
-          same_bits ? ", bitwise the serial run" : "");
-      CHECK(ids_match);
-      CHECK(history_error <= 1e-12);
-      CHECK(field_error <= 1e-10);
-      CHECK(probe_error <= 1e-10);
-      if (scene.name.find("disks") != std::string::npos) CHECK(probe_rows > 0);
-      if (ranks == 1) CHECK(same_bits);
-      if (scene.crosses > 0 && ranks >= scene.crosses) CHECK(!moved.empty());
-      // Stages: the same statuses, steps and times.
-      if (summary0.contains("stages")) {
-        REQUIRE(summary["stages"].size() == summary0["stages"].size());
-        for (size_t k = 0; k < summary0["stages"].size(); ++k) {
-          const auto &s = summary["stages"][k], &s0 = summary0["stages"][k];
-          std::printf("  stage %zu '%s': %s after %ld steps (serial: %s after %ld)\n", k,
-                      s0["name"].get<std::string>().c_str(), s["status"].get<std::string>().c_str(),
-                      s["steps"].get<long>(), s0["status"].get<std::string>().c_str(),
-                      s0["steps"].get<long>());
-          CHECK(s["status"] == s0["status"]);
-          CHECK(s["steps"] == s0["steps"]);
-        }
-      }
-      CHECK(summary["particles_created"] == summary0["particles_created"]);
-      CHECK(summary["particles_removed"] == summary0["particles_removed"]);
-      if (scene.name.find("sink") != std::string::npos) {
-        std::printf("  created %s, removed %s particles\n",
-                    summary["particles_created"].dump().c_str(),
-                    summary["particles_removed"].dump().c_str());
-        CHECK(summary0["particles_created"].get<long>() > 0);
-        CHECK(summary0["particles_removed"].get<long>() > 0);
-      }
-    }
-    // Repeated at the last rank count: the same bits (the neighbour order is fixed). Once per
-    // shape function.
+    const SerialRun serial = run_serially(scene, dir.path);
+    for (int ranks : rank_counts) check_run_on_ranks(scene, serial, dir.path, ranks);
     if (scene.name.find("column") == std::string::npos) continue;
     const int ranks = rank_counts.back();
-    const std::string out = "np" + std::to_string(ranks);
-    const auto again = run_on(dir.path, out + "_again", ranks);
+    const fs::path out = dir.path / ("np" + std::to_string(ranks));
+    const auto again = run_on(dir.path, "again", ranks);
     REQUIRE(again.exit_code == 0);
+    const long last = serial.frames.back();
     for (const auto& set : scene.sets)
-      CHECK(
-          frames_identical(read_frame(dir.path / out, frame_ids.back(), ranks, set),
-                           read_frame(dir.path / (out + "_again"), frame_ids.back(), ranks, set)));
+      CHECK(frames_identical(read_frame(out, last, ranks, set),
+                             read_frame(dir.path / "again", last, ranks, set)));
   }
 }
 

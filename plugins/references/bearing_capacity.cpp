@@ -46,7 +46,7 @@ class BearingCapacity : public Reference<D> {
         .required();
     return s;
   }
-  explicit BearingCapacity(const Params& p) : params_(p) {}
+  explicit BearingCapacity(const Params& p) : params_(p), width_(p.real("width")) {}
 
   void setup(Simulation<D>& sim, Diagnostics& diag) override {
     const auto& w = params_.vec("window");
@@ -70,7 +70,7 @@ class BearingCapacity : public Reference<D> {
 
   void sample(Simulation<D>& sim) override {
     if (slot_ < 0 || sim.time < t0_ || sim.time > t1_) return;
-    sum_ += -sim.reactions.force(size_t(slot_))[D - 1] / params_.real("width");
+    sum_ += -sim.reactions.force(size_t(slot_))[D - 1] / width_;
     count_ += 1;
   }
 
@@ -97,6 +97,7 @@ class BearingCapacity : public Reference<D> {
 
  private:
   Params params_;
+  double width_;  // b
   long slot_ = -1;
   double t0_ = 0, t1_ = 0;
   double sum_ = 0, count_ = 0;
