@@ -111,6 +111,16 @@ class ShapeFunction {
   /// and CPDI, whose weights are the hat averaged over a particle domain inside the grid, share
   /// it.
   virtual double axis_node_volume(int i, int last) const { return i == 0 || i == last ? 0.5 : 1.0; }
+  /// sum_k N_i(x_k) / ppc over the lattice x_k = (k + 1/2) h / ppc, k in [0, last ppc): the
+  /// nodal volume of node i in cell units as particles generated on the grid-aligned lattice
+  /// (framework/body_lattice.hpp) integrate it. A field that compares a particle sum with a
+  /// nodal volume (the double-point porosity 1 - V_s,I / V_I) needs this one, or it sees a full
+  /// node as partly empty. Default axis_node_volume: the lattice integrates the linear tents
+  /// exactly (linear on each sub-cell), and GIMP's and CPDI's weights, domain averages of the
+  /// tents over domains that tile the grid.
+  virtual double axis_node_lattice_volume(int i, int last, int /*points_per_cell*/) const {
+    return axis_node_volume(i, last);
+  }
   /// The per-cell pressure space that its nodal forces can balance (framework/cell_projection.hpp):
   /// constant where a cell's nodal forces depend only on its particles' mean pressure (the
   /// linear tents; GIMP and CPDI integrate the tents' gradients), linear where the gradients
