@@ -304,7 +304,7 @@ TEST_CASE("hydraulic: a prescribed pore pressure follows its time function",
 
 TEST_CASE("hydraulic: conflicting or misplaced conditions are located errors",
           "[two_phase][hydraulic][cli]") {
-  // Reference: README's error contract: FILE:LINE:COL: error: key.path: message, all at once,
+  // Reference: docs/runs.md's error contract (Exit codes): FILE:LINE:COL: error: key.path: message, all at once,
   // exit 2, nothing written.
   loam_test::TempDir dir("hydraulic_bad");
   std::filesystem::create_directories(dir.path);

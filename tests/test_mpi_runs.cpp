@@ -1020,7 +1020,7 @@ TEST_CASE("mpirun: the grid output, each rank's own nodes, is the serial run's g
 
 TEST_CASE("loam run --profile: seconds per phase, and every rank's under mpirun",
           "[mpi][mpi_run][profile]") {
-  // README "Using it": summary.json's profile_seconds times the step's phases; under mpirun
+  // docs/runs.md, Commands: summary.json's profile_seconds times the step's phases; under mpirun
   // profile_seconds_by_rank holds each rank's, the halo exchange and the migration among them.
   TempDir dir("mpi_profile");
   fs::create_directories(dir.path);
