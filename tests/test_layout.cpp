@@ -76,9 +76,9 @@ TEST_CASE("test names contain no semicolon (ctest would split them and run nothi
 
 TEST_CASE("every built-in plugin is one file named as its YAML type, in its kind's folder",
           "[layout]") {
-  // One concept per file, grouped by kind (docs/architecture.md, Layout): materials/, shapefunctions/,
-  // schemes/, plugins/<kind>/. A plugin registered by the test binary itself or loaded from a
-  // library is not built-in and is skipped.
+  // One concept per file, grouped by kind (docs/architecture.md, Layout): materials/,
+  // shapefunctions/, schemes/, plugins/<kind>/. A plugin registered by the test binary itself or
+  // loaded from a library is not built-in and is skipped.
   const std::map<std::string, std::string> folder = {
       {"material", "materials"},     {"shape_function", "shapefunctions"},
       {"scheme", "schemes"},         {"boundary", "plugins/boundaries"},
