@@ -10,8 +10,9 @@
 //     Q (w - v) = -n grad(p)   (excess pore pressure p)   <=>   q = -(k / gamma_w) grad(p),
 // hence for Darcy Q = n^2 gamma_w / k = n^2 mu_w / kappa (k hydraulic conductivity in m/s,
 // kappa intrinsic permeability in m^2, k = kappa gamma_w / mu_w, gamma_w = rho_w g).
-// A scheme that writes the water momentum per unit WATER volume, as seed 001 does (its eq. 11,
-// coefficient n gamma_w / k), uses Q / n there: n gamma_w / k for Darcy.
+// A scheme that writes the water momentum per unit WATER volume, as the FEM-and-MPM comparison
+// of large-strain consolidation does (seed 001, eq. 11, coefficient n gamma_w / k; its copy names
+// no title or authors, docs/verification.md lists it), uses Q / n there: n gamma_w / k for Darcy.
 // Time step: Q relaxes w - v at a rate of about Q / (n rho_w) (plus Q / ((1 - n) rho_s) for the
 // skeleton); an explicit drag update needs dt < ~2 n rho_w / Q, which low permeability makes
 // tiny; an implicit (node-wise) drag update has no such limit.

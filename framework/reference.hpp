@@ -26,6 +26,13 @@ struct SampleClock {
   void restart() { next = 0; }
 };
 
+/// Two metrics of a reference shown side by side at the end of a run (framework/run_report.hpp,
+/// summary.json verify.comparisons): the measured value and the value it is compared with, both
+/// keys of metrics(), and where that value comes from (a paper by author and year, a solution).
+struct Comparison {
+  std::string measured, reference, source;
+};
+
 template <int D>
 class Reference {
  public:
@@ -35,6 +42,10 @@ class Reference {
   /// Called at the end of every step.
   virtual void sample(Simulation<D>&) {}
   virtual std::map<std::string, double> metrics(Simulation<D>&) = 0;
+  /// The pairs of metrics() to show side by side, given its values; default none.
+  virtual std::vector<Comparison> comparisons(const std::map<std::string, double>&) const {
+    return {};
+  }
   /// A time series the reference recorded (column name, values; the first column is usually
   /// the time), or empty: written to summary.json (verify.series) and to verify.csv.
   virtual std::vector<std::pair<std::string, std::vector<double>>> series() const { return {}; }

@@ -145,6 +145,10 @@ class Run {
   nlohmann::json stage_records_ = nlohmann::json::array();
   /// The record of the running stage as it ends ("static", "not_static", "done", ...).
   nlohmann::json stage_record(const std::string& status);
+  /// The terminal's end of a finished run: the "done:" line and the run report
+  /// (framework/run_report.hpp), or with --quiet the report's one line.
+  void report_end(const nlohmann::json& summary, const std::string& out_dir, double particles,
+                  double wall) const;
   /// The frame interval of stage k: the last stage up to k that sets one, or output:.
   void frame_interval(int k, long& every_steps, double& every_time) const;
   CheckpointImage good_image_;

@@ -17,6 +17,7 @@
 #include "cores.hpp"
 #include "interrupt.hpp"
 #include "run.hpp"
+#include "run_report.hpp"
 #include "simulation.hpp"
 
 namespace loam {
@@ -588,6 +589,23 @@ void Run<D>::frame_interval(int k, long& every_steps, double& every_time) const 
 }
 
 template <int D>
+void Run<D>::report_end(const nlohmann::json& summary, const std::string& out_dir, double particles,
+                        double wall) const {
+  const Simulation<D>& sim = *sim_;
+  if (opt_.quiet) {
+    std::printf("%s\n", run_report_line(summary, out_dir).c_str());
+    return;
+  }
+  spdlog::info(
+      "done: {} steps, {} particles, {:.3g} s wall, {:.3g} M particle-steps/s on {} thread(s){}",
+      sim.step, particles, wall, summary["particle_steps_per_second"].get<double>() / 1e6,
+      sim.threads,
+      sim.ranks->distributed() ? fmt::format(" x {} MPI rank(s)", sim.ranks->size())
+                               : std::string());
+  for (const std::string& line : run_report(summary, out_dir)) spdlog::info("  {}", line);
+}
+
+template <int D>
 nlohmann::json Run<D>::stage_record(const std::string& status) {
   Simulation<D>& sim = *sim_;
   const Stage<D>& st = sim.stages[size_t(ls_.stage)];
@@ -922,8 +940,16 @@ RunResult Run<D>::loop() {
   res.summary["verify"] = nlohmann::json::object();  // always there: empty without a reference
   if (sim.reference) {
     nlohmann::json v = nlohmann::json::object();
-    for (const auto& [k, x] : sim.reference->metrics(sim)) v[k] = x;
+    const std::map<std::string, double> metrics = sim.reference->metrics(sim);
+    for (const auto& [k, x] : metrics) v[k] = x;
     v["reference"] = cfg_.params.section("verify").type();
+    for (const Comparison& c : sim.reference->comparisons(metrics))
+      if (metrics.count(c.measured) && metrics.count(c.reference))
+        v["comparisons"].push_back({{"measured", c.measured},
+                                    {"value", metrics.at(c.measured)},
+                                    {"reference", c.reference},
+                                    {"reference_value", metrics.at(c.reference)},
+                                    {"source", c.source}});
     const auto series = sim.reference->series();
     for (const auto& [name, values] : series) v["series"][name] = values;
     res.summary["verify"] = v;
@@ -1033,12 +1059,8 @@ RunResult Run<D>::loop() {
       std::error_code ec;
       fs::remove(file, ec);
     }
-  if (!opt_.quiet && opt_.report && failure.empty() && !interrupted)
-    spdlog::info(
-        "done: {} steps, {} particles, {:.3g} s wall, {:.3g} M particle-steps/s on {} thread(s){}",
-        sim.step, particles, wall, res.summary["particle_steps_per_second"].get<double>() / 1e6,
-        sim.threads,
-        distributed ? fmt::format(" x {} MPI rank(s)", sim.ranks->size()) : std::string());
+  if (opt_.report && failure.empty() && !interrupted && sim.ranks->root())
+    report_end(res.summary, files ? dir_.string() : std::string(), particles, wall);
   return res;
 }
 

@@ -10,7 +10,9 @@ namespace loam {
 /// the deformation F = F_now F_ref^-1 since a reference state (both row-major D x D):
 /// sqrt(sum_i ln^2 lambda_i) over the principal stretches lambda_i (in 2D plane strain the
 /// out-of-plane stretch is 1). For small strain it is sqrt(eps : eps) of the small-strain tensor,
-/// the measure of seed 004's Figure 9 (its eq. 3); unlike that tensor, a rigid rotation gives 0.
+/// the measure of Figure 9 (eq. 3) of the FEM-and-MPM analysis of a hypothetical Mohr-Coulomb
+/// slope (seed 004; its copy names no title or authors, docs/verification.md lists it); unlike
+/// that tensor, a rigid rotation gives 0.
 template <int D>
 double hencky_strain_norm(const double* F_now, const double* F_ref) {
   using Mat = Eigen::Matrix<double, D, D>;

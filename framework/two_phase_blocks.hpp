@@ -114,7 +114,9 @@ void constrain_two_phase_update(Simulation<D>& sim, double* records, const TwoPh
 /// / (2 a) with a = det R, b = K11 R22 + K22 R11, c0 = det K = M n K_w. The drag couples the
 /// phases and slows the wave towards the undrained one, sqrt((M + K_w/n) / rho_sat), but with a
 /// large permeability (or the explicit part of the update) the fast wave is this one: 12 %
-/// faster for seed 001 (1857 vs 1664 m/s), where the undrained speed let USL diverge at cfl 0.72.
+/// faster for the consolidation column of the FEM-and-MPM large-strain consolidation paper (seed
+/// 001 in docs/verification.md; 1857 vs 1664 m/s), where the undrained speed let USL diverge at
+/// cfl 0.72.
 inline double fast_wave_speed2(double M, double n, double rho_d, double Kw, double rho_w) {
   const double K11 = M + (1 - n) * (1 - n) * Kw / n, K22 = n * Kw;
   const double R11 = rho_d, R22 = n * rho_w;

@@ -28,8 +28,9 @@
 // scheme in cells shared with grains; docs/verification.md F): mu_eff = mu (1 + 2.5 c + 5.2 c^2)
 // with c = 1 - n the solid concentration, n the particle's `porosity` field where it has one (the
 // double-point scheme's liquid points: the porosity of the step), 1 elsewhere. 2.5 c is
-// Einstein's dilute limit; the form with 5.2 c^2 is the one the seed's references give for
-// Anura3D.
+// Einstein's dilute limit; the form with 5.2 c^2 is the one the sources of Liang, Zhao &
+// Martinelli, "MPM simulations of the interaction between water jet and soil bed" (seed 003) give
+// for Anura3D.
 // Sound speed: c^2 = dp/drho = K / rho0 for this equation of state, the same for every density
 // (a compressed particle is stiffer, tangent bulk modulus K rho / rho0, but also denser: the
 // two cancel), and in the cavitated state dp/drho = 0. The CFL speed is therefore sqrt(K / rho0).

@@ -1,7 +1,8 @@
 // Soil and water as two sets of material points on one grid, moving separately and free to
-// occupy the same place: the double-point ("dual particle") formulation of seed 003 (its eqs.
-// 1-12; Bandara & Soga 2015; Anura3D's double-point scheme, docs/verification.md F). Pure water,
-// dry soil and saturated soil live in one model.
+// occupy the same place: the double-point ("dual particle") formulation of Liang, Zhao &
+// Martinelli, "MPM simulations of the interaction between water jet and soil bed" (seed 003),
+// eqs. 1-12; Bandara & Soga 2015; Anura3D's double-point scheme, docs/verification.md F. Pure
+// water, dry soil and saturated soil live in one model.
 //
 // Sets. `solid`: the grains (the skeleton); the material is the effective-stress model (the
 // `stress` field is sigma', tension positive) and its density the grain density rho_s; the

@@ -1,5 +1,7 @@
 // Saturated soil with one set of material points carrying both phases: the v-w formulation of
-// seed 001 (its eqs. 11-17; Jassim, Stolle & Vermeer 2013; Zabala & Alonso 2011).
+// the FEM-and-MPM comparison of large-strain consolidation (seed 001; its copy names no title or
+// authors, docs/verification.md lists it), eqs. 11-17; Jassim, Stolle & Vermeer 2013; Zabala &
+// Alonso 2011.
 //
 // Per particle: solid velocity v (the `velocity` field), water velocity w, porosity n, excess
 // pore pressure p (COMPRESSION POSITIVE, Pa), effective stress sigma' (the material's `stress`,

@@ -1,5 +1,5 @@
 // The product form of the affine transfers' per-entry algebra (framework/affine_transfer.hpp,
-// issue 17's speed): on a tensor-product stencil the P2G's momenta m v_p + m C (x_I - x_p) are
+// written for speed): on a tensor-product stencil the P2G's momenta m v_p + m C (x_I - x_p) are
 // sums of per-axis terms (Momenta) and the G2P's B_p = sum_k w_k v_k (x_k - x_p)^T is summed per
 // axis node (MomentSum). Reference: the same stencil given per entry (the form CPDI and the node
 // coordinates use), the textbook sums. Expected: the momenta bit for bit (the per-axis terms

@@ -1,8 +1,8 @@
-// APIC transfers in the single-phase scheme (issue 17, deliverable 1; schemes/single_phase.cpp,
-// Jiang et al. 2015): a free elastic disk spinning about its centre keeps its angular momentum to
-// round-off with APIC, with gimp, bspline2 and cpdi, and keeps spinning for 10 revolutions; the
-// PIC transfer loses both. Linear tents carry C_p instead of B_p (the scheme's header says why):
-// bounded, but angular momentum only nearly kept. Bad input gives located errors.
+// APIC transfers in the single-phase scheme (docs/transfers.md, docs/verification.md U;
+// schemes/single_phase.cpp, Jiang et al. 2015): a free elastic disk spinning about its centre keeps
+// its angular momentum to round-off with APIC, with gimp, bspline2 and cpdi, and keeps spinning for
+// 10 revolutions; the PIC transfer loses both. Linear tents carry C_p instead of B_p (the scheme's
+// header says why): bounded, but angular momentum only nearly kept. Bad input gives located errors.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
@@ -173,8 +173,8 @@ TEST_CASE(
   // configs/vibrating_bar.yaml (docs/verification.md A: 10 periods of the first mode, 1D), its
   // reference's energy_drift (largest |E - E0| / E0 of the particles' kinetic plus strain energy)
   // with transfer: apic and tpic against the FLIP/PIC blend flip: 0.98 that granular scenes use,
-  // for gimp and bspline2 (issue 17: at least 5x smaller). Measured 2026-12-04: APIC gimp
-  // 0.64 % against 14.0 %, bspline2 1.01 % against 18.0 % (pure FLIP: 0.51 % with gimp); TPIC
+  // for gimp and bspline2 (target: at least 5x smaller, docs/verification.md U). Measured: APIC
+  // gimp 0.64 % against 14.0 %, bspline2 1.01 % against 18.0 % (pure FLIP: 0.51 % with gimp); TPIC
   // 0.70 % and 1.13 %. Linear tents take the affine transfers with update: usf (the scheme's
   // header), where TPIC is APIC, so both runs use it there and only APIC runs.
   for (const char* shape : {"gimp", "bspline2", "linear"}) {

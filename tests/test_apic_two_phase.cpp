@@ -1,4 +1,4 @@
-// APIC in the two-phase schemes (issue 17, deliverable 1; framework/affine_transfer.hpp). The
+// APIC in the two-phase schemes (docs/transfers.md; framework/affine_transfer.hpp). The
 // single-point scheme (schemes/two_phase_single_point.cpp): each particle carries B_p of the
 // solid and of the water velocity; the double-point scheme (schemes/two_phase_double_point.cpp):
 // each solid or liquid point carries B_p of its own phase's velocity. A saturated disk spinning
@@ -125,8 +125,9 @@ TEST_CASE("apic two-phase: a spinning saturated disk keeps its angular momentum,
 TEST_CASE("apic two-phase: the Terzaghi column consolidates as with FLIP",
           "[apic][transfer][two_phase][verification]") {
   // configs/seed001_terzaghi.yaml (docs/verification.md C) with gimp, FLIP against APIC: both
-  // within the issue's 0.03 p0 of the series at every sampled time factor, and within 0.005 p0 of
-  // each other (a 1D column at rest but for the consolidation: the transfers barely differ).
+  // within 0.03 p0 (the double-point target of docs/verification.md F) of the series at every
+  // sampled time factor, and within 0.005 p0 of each other (a 1D column at rest but for the
+  // consolidation: the transfers barely differ).
   loam_test::TempDir f("terzaghi_flip_gimp"), a("terzaghi_apic_gimp");
   const std::string base = "--threads 1 --set shape_function=gimp";
   const auto sf = loam_test::run_scene("seed001_terzaghi.yaml", f.path, base);

@@ -1,4 +1,4 @@
-// Seed 002's Aznalcóllar dam (issue 16, deliverable 4; configs/seed002_aznalcollar.yaml,
+// Seed 002's Aznalcóllar dam (configs/seed002_aznalcollar.yaml,
 // docs/aznalcollar.md): a rockfill dam raised downstream in four stages on a brittle,
 // overconsolidated clay with a weaker bedding layer 14 m below the ground, tailings pressing on
 // its upstream face and on the lagoon floor, two-phase single point, until it slides. The quick

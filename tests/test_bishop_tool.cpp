@@ -1,9 +1,9 @@
-// tools/bishop.py, the limit-equilibrium check of issue 15's strength reduction (Bishop's
-// simplified method over circular slip surfaces), against the two textbook solutions it
-// reproduces: an infinite cohesionless slope, F = tan(phi) / tan(beta) (shallow circles
-// approach it from above), and Taylor's (1937) stability number for phi = 0 toe circles at
-// beta = 60 deg, N_s = c / (F gamma H) = 0.191. Steeper faces are not reproduced yet: at 75
-// and 90 deg the tool's minimum is 3 % and 12 % less critical than Taylor's 0.219 and 0.261
+// tools/bishop.py, the limit-equilibrium check of the strength reduction
+// (docs/strength_reduction.md; Bishop's simplified method over circular slip surfaces), against the
+// two textbook solutions it reproduces: an infinite cohesionless slope, F = tan(phi) / tan(beta)
+// (shallow circles approach it from above), and Taylor's (1937) stability number for phi = 0 toe
+// circles at beta = 60 deg, N_s = c / (F gamma H) = 0.191. Steeper faces are not reproduced yet: at
+// 75 and 90 deg the tool's minimum is 3 % and 12 % less critical than Taylor's 0.219 and 0.261
 // (docs/verification.md J); they are printed only.
 #include <catch2/catch.hpp>
 #include <cmath>

@@ -1,4 +1,4 @@
-// Seed 002's blasting problem (issue 16, deliverable 3; configs/seed002_blast_3d.yaml,
+// Seed 002's blasting problem (configs/seed002_blast_3d.yaml,
 // docs/blast.md): a pressure pulse in a borehole in granite under sand, a quarter model with
 // absorbing far faces. The blast_wave reference compares first-break arrival times at the probes
 // with the layers' P-wave speeds (Fermat rays, docs/verification.md H) and records peak

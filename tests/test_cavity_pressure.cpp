@@ -1,4 +1,4 @@
-// Pressure on a cavity (issue 16, deliverable 2; plugins/loads/cavity_pressure.cpp, the
+// Pressure on a cavity (docs/verification.md N; plugins/loads/cavity_pressure.cpp, the
 // `cylinder` and `difference` generators): the loaded wall carries the cavity's area and the
 // right resultant, and a pressurised hole in an elastic body gives Lamé's stresses
 // (docs/verification.md N).
@@ -174,7 +174,7 @@ TEST_CASE("cavity_pressure: a pressurised hole in an elastic plate gives Lame's 
   // (b -> infinity: Kirsch's -p (a/r)^2 and +p (a/r)^2). Quarter model a = 1 m, b = 6 m, the
   // pressure ramped over 0.5 s and held, local damping to static at 3 s. The mean of each
   // stress over the particles of a ring must be within 5 % of Lamé's mean over the same
-  // particles, for rings between 2a and 4a (the issue's r >= 2a; beyond 4a the stress is
+  // particles, for rings between 2a and 4a (the target's r >= 2a; beyond 4a the stress is
   // below 6 % of p and the lattice's staircase outer surface weighs in).
   const double p = 1.0e4, a = 1, b = 6;
   for (const char* shape : {"gimp", "bspline2"}) {

@@ -1,7 +1,7 @@
-// Checkpoint and resume (issue 14, deliverable 1; framework/checkpoint.hpp, runner.cpp): a run
-// resumed from a checkpoint taken between two output frames gives bitwise the frames, history,
-// probes, XDMF index and summary numbers of the uninterrupted run, for single_phase,
-// two_phase_single_point and two_phase_double_point, and across thread counts; an
+// Checkpoint and resume (docs/runs.md, Checkpoints and Resume; framework/checkpoint.hpp,
+// runner.cpp): a run resumed from a checkpoint taken between two output frames gives bitwise the
+// frames, history, probes, XDMF index and summary numbers of the uninterrupted run, for
+// single_phase, two_phase_single_point and two_phase_double_point, and across thread counts; an
 // interrupted run (SIGINT through a real process) resumes to the uninterrupted final state; a
 // checkpoint of another configuration is refused; `keep` keeps the newest N.
 #include <catch2/catch.hpp>

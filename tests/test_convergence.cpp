@@ -91,8 +91,8 @@ namespace {
 
 /// The soft column (configs/soft_column_2d.yaml) at cell size h = H / cells_per_height with
 /// every shape function. Reference: sigma_v at a material point = -rho0 g (H - Z) under lateral
-/// confinement, for any strain. Issue 4: GIMP, CPDI and B-spline give a stress error at least
-/// 3x smaller than linear at the finest resolution.
+/// confinement, for any strain. Target (docs/convergence.md, Soft column under gravity): GIMP, CPDI
+/// and B-spline give a stress error at least 3x smaller than linear at the finest resolution.
 void soft_column_smooth_beat_linear(int cells_per_height) {
   const double h = 1.0 / cells_per_height;
   std::map<std::string, double> err;
@@ -116,7 +116,7 @@ void soft_column_smooth_beat_linear(int cells_per_height) {
 
 TEST_CASE("soft column at the finest grid: smooth shape functions beat linear 3x on stress",
           "[verification][convergence][full]") {
-  soft_column_smooth_beat_linear(64);  // issue 4's finest grid, h = H/64
+  soft_column_smooth_beat_linear(64);  // the finest grid of docs/convergence.md, h = H/64
 }
 
 TEST_CASE("soft column at h = H/32: smooth shape functions beat linear 3x on stress",

@@ -379,7 +379,8 @@ TEST_CASE("cpdi stops with a clear message: inverted, too stretched, corner outs
 
 TEST_CASE("vibrating bar with cpdi through the CLI: period and energy (docs/verification.md A)",
           "[shape][verification]") {
-  // T = 4L/c = 10 s; tolerances as for linear (issue 3): period error < 1 %, energy drift < 1 %.
+  // T = 4L/c = 10 s; tolerances as for linear (docs/verification.md A): period error < 1 %, energy
+  // drift < 1 %.
   loam_test::TempDir dir("bar_cpdi");
   auto s = loam_test::run_scene("vibrating_bar.yaml", dir.path, "--set shape_function=cpdi");
   auto v = s["verify"];

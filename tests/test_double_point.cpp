@@ -19,8 +19,8 @@ namespace {
 /// Max |p/p0 - exact| at each time factor from the run's terzaghi reference (verify:).
 void check_terzaghi_double_point(const std::string& config, const std::string& extra = "") {
   // Reference: docs/verification.md C, the one-way drainage series with c_v = k M / gamma_w =
-  // 1.0194 m^2/s, H = 1 m. Target (issue 13): max |p/p0 - exact| <= 0.03 at T = 0.1, 0.2, 0.5,
-  // 1 (the pressure of the liquid points), and the degree of consolidation within 0.01.
+  // 1.0194 m^2/s, H = 1 m. Target (docs/verification.md F): max |p/p0 - exact| <= 0.03 at T = 0.1,
+  // 0.2, 0.5, 1 (the pressure of the liquid points), and the degree of consolidation within 0.01.
   loam_test::TempDir dir("dp_terzaghi");
   auto s =
       loam_test::run_scene(config, dir.path, "--threads 1 --set output.every_time=10 " + extra);
@@ -365,9 +365,9 @@ TEST_CASE("double point: permeameter flow rates follow Darcy and Ergun",
   // the flux U and the gradient i in the sample must satisfy Darcy, U = k i (k = 1e-3 m/s), or
   // Ergun, gamma_w i = a U + b U^2 with a = 150 mu (1 - n)^2 / (n^3 d^2), b = 1.75 (1 - n)
   // rho_w / (n^3 d), for d = 0.258 mm (seed 003's sand: laminar, b U^2 0.5 % of the gradient)
-  // and d = 5 mm (84 % inertial). Target 2 % (issue 13). The coarse sample is measured at
-  // t = 0.5 s: later the liquid points that entered it are spaced s/n (0.8 per cell), and the
-  // cell pressures scatter by kPa (docs/verification.md F).
+  // and d = 5 mm (84 % inertial). Target 2 % (docs/verification.md D, F). The coarse sample is
+  // measured at t = 0.5 s: later the liquid points that entered it are spaced s/n (0.8 per cell),
+  // and the cell pressures scatter by kPa (docs/verification.md F).
   struct Case {
     const char* label;
     std::string drag;
@@ -651,10 +651,10 @@ TEST_CASE("seed 003 water jet 2D quick: the jet scours a pit that deepens in the
 
 TEST_CASE("seed 003 water jet 2D: a faster jet scours deeper at 1 s (17 then 22 then 27 m/s)",
           "[scene][double_point][full]") {
-  // Issue 13's acceptance: the scour depth at 1 s increases with the jet speed (the paper:
-  // "as the jet speed increases, the displacement of the soil particles also increases").
-  // The shipped resolution (0.125 m cells); measured 2026-12-02: 0.47, 0.62, 0.74 m. Each run
-  // ends at 1 s with the mass balance at round-off.
+  // The published trend (docs/verification.md F, "Seed 003 water jet"): the scour depth at 1 s
+  // increases with the jet speed (the paper: "as the jet speed increases, the displacement of the
+  // soil particles also increases"). The shipped resolution (0.125 m cells); measured 2026-12-02:
+  // 0.47, 0.62, 0.74 m. Each run ends at 1 s with the mass balance at round-off.
   double prev = 0;
   for (int v : {17, 22, 27}) {
     const Scour s = water_jet("seed003_water_jet_2d.yaml",

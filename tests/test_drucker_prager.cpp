@@ -1,5 +1,5 @@
-// Unit tests of the drucker_prager material at one material point (issue 17, deliverable 3;
-// materials/drucker_prager.cpp, docs/verification.md B2), driven through MaterialBatch, and its
+// Unit tests of the drucker_prager material at one material point
+// (materials/drucker_prager.cpp, docs/verification.md B2), driven through MaterialBatch, and its
 // parameter checks through the command line. Formulas use compression positive (sigma'_1 >=
 // sigma'_3), the material tension positive.
 #include <Eigen/Dense>

@@ -1,4 +1,4 @@
-// A fuzzed input suite (issue 14, deliverable 6): configs mutated from the shipped ones (typos,
+// A fuzzed input suite: configs mutated from the shipped ones (typos,
 // deleted and duplicated lines, wrong types, junk characters, extreme numbers, empty maps, a cut
 // file) go through `loam check` (1200 of them) and a sample through a short `loam run` (60):
 // never a crash, a hang (20 s limit) or an exit code other than 0 or 2 (check) / 0, 2 or 3 (run),

@@ -192,8 +192,8 @@ TEST_CASE(
 
 TEST_CASE("granular collapse 2D with APIC and no PIC blend comes to rest",
           "[verification][scene][apic]") {
-  // Issue 17: the collapse with transfer: apic (gimp, MUSL; linear tents take APIC with USF
-  // only, framework/affine_transfer.hpp) and no PIC
+  // The collapse with transfer: apic (gimp, MUSL; linear tents take APIC with USF
+  // only, framework/affine_transfer.hpp; docs/transfers.md, The granular collapse) and no PIC
   // blend, beside the flip: 0.98 run on the same gimp grid and Lube et al. (2005). The test
   // asserts that it comes to rest (final max speed below 0.1 m/s, as the quick test above) and
   // prints the deposit. Measured 2026-12-04, cell 0.02 m, run-out ratio / height ratio (Lube

@@ -139,7 +139,7 @@ TEST_CASE("hydraulic: a fixed, drained base drains like a free drained top (mirr
   // T = c_v t / H^2, at t = 0.3 s (T = 0.306), for the cells 0, 2 and 8 from the drained face
   // (pressure_smoothing: cell gives each particle its cell's mean, so compare at the cell
   // centres z' = 0.0125, 0.0625, 0.2125 m). The free top meets it within 6e-4 p0; target for
-  // both: 0.005 p0. Before the drag re-solve of the released water (issue 11.2) the base was
+  // both: 0.005 p0. Before the drag re-solve of the released water the base was
   // -62 / 408 / 1797 Pa against 118 / 588 / 1965 (0.018 p0 off: the water leaving the fixed
   // base was dragged by the solve's free-solid velocity) and settled 2.5 % more than the top.
   // Settlement: the two columns' final_settlement within 1 % of each other. The same for the
@@ -304,8 +304,8 @@ TEST_CASE("hydraulic: a prescribed pore pressure follows its time function",
 
 TEST_CASE("hydraulic: conflicting or misplaced conditions are located errors",
           "[two_phase][hydraulic][cli]") {
-  // Reference: docs/runs.md's error contract (Exit codes): FILE:LINE:COL: error: key.path: message, all at once,
-  // exit 2, nothing written.
+  // Reference: docs/runs.md's error contract (Exit codes): FILE:LINE:COL: error: key.path: message,
+  // all at once, exit 2, nothing written.
   loam_test::TempDir dir("hydraulic_bad");
   std::filesystem::create_directories(dir.path);
   const auto cfg = dir.path / "run.yaml";

@@ -1,7 +1,7 @@
 // Invariances every scheme must keep, for every update variant and shape function a user can
-// configure (issue 11): a rigid translation gives no stress and no pore pressure, also for a
-// block sliding along a held (slip) face of the grid, and a rigid spin gives no strain rate.
-// They test the transfer mechanism itself (partition of unity, zero gradient sum and linear
+// configure (docs/verification.md M): a rigid translation gives no stress and no pore pressure,
+// also for a block sliding along a held (slip) face of the grid, and a rigid spin gives no strain
+// rate. They test the transfer mechanism itself (partition of unity, zero gradient sum and linear
 // reproduction of the stencils, the MUSL re-map on the start-of-step stencil), not a scene.
 #include <catch2/catch.hpp>
 #include <cmath>

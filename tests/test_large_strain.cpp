@@ -1,6 +1,6 @@
 // Seed 001 large-strain consolidation (configs/seed001_large_strain.yaml; docs/verification.md C,
-// "Seed 001 large strain"): a soft column (M = 100 kPa) under 50 kPa consolidates to
-// exp(-0.5) = 0.6065 m (jaumann) or 0.7035 m (hencky). Target (issue 6): final height within 1 %
+// "Seed 001, large strain"): a soft column (M = 100 kPa) under 50 kPa consolidates to
+// exp(-0.5) = 0.6065 m (jaumann) or 0.7035 m (hencky). Target: final height within 1 %
 // of the exact value of each formulation. The reference plugin consolidated_height computes the
 // exact values; they are checked here against hand-computed numbers first.
 #include <catch2/catch.hpp>

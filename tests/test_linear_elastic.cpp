@@ -1,5 +1,5 @@
-// Unit tests of the two large-deformation formulations of linear_elastic (issue 6 item 5,
-// docs/verification.md C "Seed 001 large strain"): jaumann (hypoelastic Cauchy stress, Jaumann
+// Unit tests of the two large-deformation formulations of linear_elastic
+// (docs/verification.md C "Seed 001, large strain"): jaumann (hypoelastic Cauchy stress, Jaumann
 // rate) and hencky (hyperelastic Kirchhoff stress of the logarithmic strain). Paths run through the
 // element-test driver (framework/element_test.hpp) and through one material point in 1D, 2D and
 // 3D whose volume and deformation gradient are updated as the schemes do (V *= det(I + L dt),

@@ -1,4 +1,4 @@
-// Whole runs under mpirun (issue 18, docs/parallel.md "Tests"): `mpirun -np N loam run` at 1, 2
+// Whole runs under mpirun (docs/parallel.md "Tests"): `mpirun -np N loam run` at 1, 2
 // and 4 ranks against the serial run of the same scene, for every shape function that runs on
 // ranks, in 1D, 2D and 3D, with particles crossing the cuts between the blocks in every
 // direction. Only in the MPI build (its loam runs on ranks).
@@ -843,7 +843,7 @@ void check_whole_runs(const std::vector<int>& rank_counts) {
 
 TEST_CASE("mpirun -np 1 and 4: whole runs match the serial run, every shape function, 1D-3D",
           "[mpi][mpi_run]") {
-  // Issue 18's acceptance. 4 ranks give every rank but the first and last two neighbours.
+  // 4 ranks give every rank but the first and last two neighbours.
   check_whole_runs({1, 4});
 }
 

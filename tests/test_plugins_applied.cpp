@@ -1,4 +1,4 @@
-// Every configured plugin is applied, by every scheme (issue 11.5: two_phase_single_point
+// Every configured plugin is applied, by every scheme (two_phase_single_point once
 // silently ignored `damping:`). The plugins of a real run are wrapped in counting decorators
 // after set-up, the run advances, and each hook the step must call is checked for every
 // scheme and update variant; every registered scheme must appear in the table, so a new

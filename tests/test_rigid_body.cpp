@@ -32,7 +32,7 @@ TEST_CASE("rigid_body: a footing's particles translate without strain and keep l
   // where its load fell to 0.44 of its peak: docs/verification.md A): min q over 0.07-0.15 m
   // >= 0.8 q(0.07 m) (linear tents dip by 12 % as the footing's particles cross a node row and
   // its nodes change; gimp does not dip). Printed against Prandtl's (2 + pi) s_u, not asserted
-  // (volumetric locking, issue 43).
+  // (volumetric locking, docs/volumetric_locking.md).
   // USF constrains the velocities before the grid update: the body's nodes must be the step's
   // there too.
   for (const auto& [shape, update] : std::vector<std::pair<std::string, std::string>>{

@@ -5,9 +5,10 @@
 //   stress ratio of the MCC flow rule; derived at closed_form() below), computed here from the
 //   config's parameters without the material code, so a constitutive error cannot cancel;
 // - loam's own oedometric element test of the same material from the same state to the same
-//   final vertical effective stress (200 kPa; issue 6: within 2 %), run here through
-//   loam::run_element_test on the material, initial stress and loads read from the config file,
-//   so the target follows the config; the config's verify.expected_settlement must agree with it.
+//   final vertical effective stress (200 kPa; target: within 2 %, docs/seed001_mcc.md), run here
+//   through loam::run_element_test on the material, initial stress and loads read from the config
+//   file, so the target follows the config; the config's verify.expected_settlement must agree with
+//   it.
 // The element test must equal the closed form (checks the material point), and the column must
 // equal both (checks the two-phase MPM column). The paper's 0.142 m is printed beside, with the
 // settlements other parameter conventions give (see the config header).
@@ -325,9 +326,10 @@ TEST_CASE("seed001 MCC: step-loaded column within 0.5 % of the closed form",
   // +0.31 % at k = 3e-3, +1.6 % at 3e-2, +2.2 % at 5e-2). Drained at 10 s.
   // Measured: +0.335 % (docs/seed001_mcc.md: +0.31 % with the code of that note). The excess
   // is the physical overshoot of the step load, not a discretisation error (ramped, the same
-  // column is the closed form to 3e-5: next test). Tolerance 0.5 % (was 2 %, the issue-6
-  // target): room for +-0.15 % change of that dynamic excess; a constitutive error, a wrong K0
-  // (rigid-plastic K0: +0.10 %) or an undrained end (B = 0.9) would still fail the ramped test.
+  // column is the closed form to 3e-5: next test). Tolerance 0.5 % (was 2 %, the target of
+  // docs/seed001_mcc.md): room for +-0.15 % change of that dynamic excess; a constitutive error, a
+  // wrong K0 (rigid-plastic K0: +0.10 %) or an undrained end (B = 0.9) would still fail the ramped
+  // test.
   check_column(
       " --set scheme.water_bulk_modulus=2.2e7 --set time.end=10 --set output.every_time=10", 5e-3);
 }

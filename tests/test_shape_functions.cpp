@@ -1,4 +1,4 @@
-// Unit tests of the gimp and bspline2 shape functions in 1D, 2D and 3D (issue 4): partition of
+// Unit tests of the gimp and bspline2 shape functions in 1D, 2D and 3D: partition of
 // unity, zero gradient sum, linear reproduction, gradient continuity across cell faces (linear as
 // the contrast), weights at and near the grid boundary, GIMP domains straddling a cell face and
 // stretched with F; for every shape function the consistency near and on every grid face, edge
@@ -857,7 +857,7 @@ TEST_CASE("every shape function: a particle on a grid face is carried by the fac
 
 TEST_CASE("vibrating bar with gimp and bspline2 through the CLI: period and energy",
           "[shape][verification]") {
-  // docs/verification.md A: T = 10 s; tolerances from issue 3/4: period error < 1 %, energy drift <
+  // docs/verification.md A: T = 10 s; tolerances as for linear: period error < 1 %, energy drift <
   // 1 %.
   for (std::string shape : {"gimp", "bspline2"}) {
     loam_test::TempDir dir("bar_" + shape);

@@ -1,7 +1,8 @@
-// The measurements of the slope scenes (issue 15): the `slope_failure` reference (the failed
-// mass, its depth, run-out, deposit top and time to rest; plugins/references/slope_failure.cpp)
-// and the `strain_magnitude` output (||eps|| of the logarithmic strain since the last reset;
-// framework/strain_measure.hpp), tested on motions whose answers are known exactly.
+// The measurements of the slope scenes (docs/slope_scenes.md): the `slope_failure` reference (the
+// failed mass, its depth, run-out, deposit top and time to rest;
+// plugins/references/slope_failure.cpp) and the `strain_magnitude` output (||eps|| of the
+// logarithmic strain since the last reset; framework/strain_measure.hpp), tested on motions whose
+// answers are known exactly.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>

@@ -1,4 +1,4 @@
-// The slope scenes of issue 15 (docs/slope_scenes.md): seed 004's large-deformation footing and
+// The slope scenes (docs/slope_scenes.md): seed 004's large-deformation footing and
 // seed 002's frictional and cohesive slopes, measured by the slope_failure reference. The
 // papers report descriptions and a few numbers; the tests assert the kind of failure each paper
 // describes and print loam's numbers beside the papers'. The quick variants run the same

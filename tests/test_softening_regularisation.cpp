@@ -1,4 +1,4 @@
-// Regularisation of strain softening (issue 16, deliverable 5; materials/strain_softening_mc.cpp
+// Regularisation of strain softening (materials/strain_softening_mc.cpp
 // `characteristic_length`, docs/verification.md T): a plane-strain biaxial specimen of a brittle
 // softening soil, compressed by a platen at a constant rate (prescribed_velocity) under a
 // confining traction, with a weak zone at its corner to start the band. Without regularisation
@@ -117,7 +117,7 @@ TEST_CASE(
   // coarse grid, 2 on the fine one). Printed: the load against the platen travel, the peak (the
   // failure load) and the load 4 mm of travel after the coarse run's peak, in the middle of
   // the softening. Targets: with l_c the failure load changes by less than 10 % between the
-  // resolutions (the issue's criterion), and the post-peak load changes less with l_c than
+  // resolutions (docs/verification.md T), and the post-peak load changes less with l_c than
   // without (measured 2026-12-04: peak -1.9 % without, +5.3 % with; 0.019 m of travel, -16.2 %
   // without, +6.9 % with).
   const double coarse = 0.1, fine = 0.05;

@@ -1,4 +1,4 @@
-// Staged analysis (issue 15, docs/stages.md): a run with one explicit stage is bitwise the plain
+// Staged analysis (docs/stages.md): a run with one explicit stage is bitwise the plain
 // run of the same time; a load added by a stage acts from exactly the stage's start; bad stage
 // input gives located errors, exit 2, and no output.
 #include <algorithm>
@@ -186,7 +186,7 @@ double sample_at(std::map<std::string, std::vector<double>>& probe, const std::s
 TEST_CASE("the seed-004 gravity stages end at rest with sigma_yy under the crest at rho g depth",
           "[stages]") {
   // configs/seed004_slope_staged.yaml, its two gravity stages (elastic, then Mohr-Coulomb; local
-  // damping, until static). Issue 15: at rest (particles moving <= 1e-5 m/s: docs/stages.md,
+  // damping, until static). Targets: at rest (particles moving <= 1e-5 m/s: docs/stages.md,
   // When a stage ends) and sigma_yy under the crest within 2 % of rho g depth. Compared per
   // cell (0.5 m): the volume-weighted particle sigma_yy against the volume-weighted
   // -rho g (9.5 m - Y), Y a particle's height at t = 0 (the weight above it), over the full

@@ -1,4 +1,4 @@
-// Strength reduction (issue 15, docs/strength_reduction.md) and the periodic grid it is tested
+// Strength reduction (docs/strength_reduction.md) and the periodic grid it is tested
 // on. The factor of safety of an infinite cohesionless slope with associated flow is
 // tan(phi) / tan(beta) (docs/strength_reduction.md, Infinite slope); trials restart from the same
 // static state (a trial's record does not depend on the trials before it); a periodic grid keeps

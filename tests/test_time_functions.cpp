@@ -1,4 +1,4 @@
-// Time functions (issue 16, deliverable 1; plugins/time_functions/): exact values at their
+// Time functions (docs/verification.md T; plugins/time_functions/): exact values at their
 // breakpoints and between them, located errors for bad input (a table whose times do not
 // increase, inline or in a file), and the factor reaching the load: a free block's momentum is
 // the traction's impulse F sum_k f(t_k) dt, and `ramp_time: T` is bitwise

@@ -1,10 +1,10 @@
 // The traction load's surface point (plugins/loads/traction.cpp, apply_at: surface) under shear and
 // rotation: the load must act at the centre of the particle's loaded face convected with its
-// deformation gradient, x_s = x_p + F (s/2) N (issue 11.8; the same convection as CPDI's domain
-// corners). The nodal forces are t A N_I(x_s) with the grid's tent functions, so their sum is
-// t A (partition of unity) and their centroid sum f_I x_I / sum f_I is x_s exactly (the tents
-// reproduce linear fields). Before, x_s = x_p + (s/2) F_nn N along the fixed axis: off by
-// s gamma / 2 tangentially under simple shear gamma, and not turning with a rotation.
+// deformation gradient, x_s = x_p + F (s/2) N (docs/verification.md M, Traction surface point; the
+// same convection as CPDI's domain corners). The nodal forces are t A N_I(x_s) with the grid's tent
+// functions, so their sum is t A (partition of unity) and their centroid sum f_I x_I / sum f_I is
+// x_s exactly (the tents reproduce linear fields). Before, x_s = x_p + (s/2) F_nn N along the fixed
+// axis: off by s gamma / 2 tangentially under simple shear gamma, and not turning with a rotation.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>

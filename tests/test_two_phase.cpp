@@ -13,7 +13,7 @@ namespace {
 
 void check_terzaghi(const std::string& config, const std::string& extra = "") {
   // Reference: docs/verification.md C, p(z,t)/p0 series with c_v = k M / gamma_w = 1.0194 m^2/s,
-  // one-way drainage, H = 1 m. Target (issue 6): max |p/p0 - exact| <= 0.02 at each T, the
+  // one-way drainage, H = 1 m. Target: max |p/p0 - exact| <= 0.02 at each T, the
   // degree of consolidation within 0.01.
   loam_test::TempDir dir("terzaghi");
   auto s =

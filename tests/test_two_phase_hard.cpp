@@ -1,4 +1,4 @@
-// Hard cases of the two_phase_single_point scheme (issue 6, item 8): a nearly impermeable soil,
+// Hard cases of the two_phase_single_point scheme: a nearly impermeable soil,
 // stiff water, porosities near 0 and 1, and a load applied in one time step (every run here: the
 // seed-001 column of configs/seed001_terzaghi.yaml, 10 kPa applied at t = 0 without a ramp).
 // Each prints dt, steps and wall time; each asserts that the run either stays physical or stops

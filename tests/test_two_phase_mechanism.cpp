@@ -1,7 +1,7 @@
-// Mechanisms of the two_phase_single_point scheme that the Terzaghi scenes do not see (issue 11):
-// its time step from the fastest wave of the two phases, the energy of both phases, and local
-// damping. Scenes: the seed-001 column (configs/seed001_terzaghi.yaml) and an undrained elastic
-// vibration of it.
+// Mechanisms of the two_phase_single_point scheme that the Terzaghi scenes do not see
+// (docs/verification.md M): its time step from the fastest wave of the two phases, the energy of
+// both phases, and local damping. Scenes: the seed-001 column (configs/seed001_terzaghi.yaml) and
+// an undrained elastic vibration of it.
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
 #include <cmath>

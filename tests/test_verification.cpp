@@ -13,7 +13,8 @@ using loam_test::TempDir;
 TEST_CASE("vibrating bar: period and energy over 10 periods (docs/verification.md A)",
           "[verification]") {
   // Reference: T = 4L/c = 10 s for L = 25 m, E = 100 Pa, rho = 1; MUSL, linear shape functions.
-  // Tolerances from issue 3: period error < 1 %, total-energy drift < 1 % over 10 periods.
+  // Tolerances (docs/verification.md A): period error < 1 %, total-energy drift < 1 % over 10
+  // periods.
   TempDir dir("bar");
   auto s = run_scene("vibrating_bar.yaml", dir.path);
   auto v = s["verify"];
@@ -37,13 +38,14 @@ TEST_CASE("vibrating bar under USL and USF also keeps its period", "[verificatio
     std::printf("vibrating bar %s: period error %.3e, energy drift %.3e\n", update.c_str(), e,
                 drift);
     CHECK(e < 0.01);
-    CHECK(drift < 0.02);  // not an issue target; USL/USF must simply not drift far
+    CHECK(drift < 0.02);  // no published target; USL/USF must simply not drift far
   }
 }
 
 TEST_CASE("elastic column 1D/2D/3D: stress vs rho g (H - z) (docs/verification.md A)",
           "[verification]") {
-  // Tolerance from issue 3: relative L2 error of sigma_v < 3 %; 2D and 3D agree with 1D within 1 %.
+  // Tolerance (docs/verification.md A): relative L2 error of sigma_v < 3 %; 2D and 3D agree with 1D
+  // within 1 %.
   std::vector<nlohmann::json> v;
   for (int d = 1; d <= 3; ++d) {
     TempDir dir("column" + std::to_string(d));

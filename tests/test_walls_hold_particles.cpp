@@ -1,4 +1,4 @@
-// Walls hold particles (issue 12, deliverable 3): a particle never crosses a grid face that a
+// Walls hold particles (docs/verification.md W): a particle never crosses a grid face that a
 // mechanical boundary condition holds (fixed, slip, friction, absorbing: Boundary::holds_face).
 // A move that would reach or cross such a face stops halfway to it (HeldFaces::moved), at every
 // place a scheme moves particles; the velocity is left alone. Leaving through an open face stays

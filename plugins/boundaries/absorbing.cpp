@@ -23,8 +23,9 @@
 // dashpot.
 //
 // Two-phase schemes (solid and pore water, e.g. two_phase_single_point): the face is an
-// IMPERMEABLE dashpot, as the viscous bottom of seed 002's consolidation column (an impervious
-// base with extra damping): water does not cross the face relative to the skeleton, so the normal
+// IMPERMEABLE dashpot, as the viscous bottom (an impervious base with extra damping) of the
+// consolidation column of "The Material Point Method: A promising computational tool in
+// Geotechnics" (seed 002): water does not cross the face relative to the skeleton, so the normal
 // velocities of solid and water at a face node are equal, and the mixture's normal dashpot acts on
 // that common velocity with the mixture's momentum,
 //     v_n^{n+1} = w_n^{n+1} = (m_s v_n* + m_w w_n*) / (m_s + m_w + dt C_n),   C_n = rho c_p A,

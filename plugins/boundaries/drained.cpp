@@ -1,5 +1,7 @@
 // Drained face of a two-phase scheme: the pore water passes the face freely, so the pore
-// pressure there is zero (the natural condition of the water's weak form, seed 001 eq. 16).
+// pressure there is zero (the natural condition of the water's weak form, eq. 16 of the FEM-and-MPM
+// comparison of large-strain consolidation, seed 001; its copy names no title or authors,
+// docs/verification.md lists it).
 // It releases the water from a mechanical condition on the same face: `fixed` + `drained` is a
 // fixed, drained base (a porous stone); see framework/hydraulic_face.hpp.
 #include "framework/hydraulic_face.hpp"

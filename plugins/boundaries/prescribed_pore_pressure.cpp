@@ -1,7 +1,9 @@
 // Prescribed pore pressure on a face of a two-phase scheme: p = `pressure` (Pa, compression
 // positive), or p = gamma_w (head - z) from a piezometric `head` (m; z the node's coordinate
 // along the last axis, the vertical). The water passes the face freely (as `drained`, which is
-// the case p = 0) and the face adds the boundary term of the weak forms (seed 001 eqs. 16-17):
+// the case p = 0) and the face adds the boundary term of the weak forms (eqs. 16-17 of the
+// FEM-and-MPM comparison of large-strain consolidation, seed 001; its copy names no title or
+// authors, docs/verification.md lists it):
 // with n_out the outward normal and A_I the node's tributary face area, the mixture gets the
 // total traction -p n_out A_I, of which the water equation (per unit pore volume, times the
 // nodal porosity n_I) takes -n_I p n_out A_I. They are nodal forces added before the scheme

@@ -1,7 +1,8 @@
 // Darcy drag (docs/verification.md D): linear in the relative velocity, per unit mixture volume
 //     Q = n^2 mu_w / kappa = n^2 gamma_w / k,   k = kappa gamma_w / mu_w,   gamma_w = rho_w g,
-// with n the current porosity (framework/drag.hpp has the convention; seed 001's per-unit-water-
-// volume coefficient n gamma_w / k is Q / n). Given either the hydraulic conductivity k (m/s,
+// with n the current porosity (framework/drag.hpp has the convention; the per-unit-water-volume
+// coefficient n gamma_w / k of the FEM-and-MPM comparison of large-strain consolidation, seed
+// 001 in docs/verification.md, is Q / n). Given either the hydraulic conductivity k (m/s,
 // then mu_w only enters hydraulic <-> intrinsic conversions) or the intrinsic permeability kappa
 // (m^2), never both. Either way k and kappa are constants: Q varies with n only through n^2.
 #include <cmath>

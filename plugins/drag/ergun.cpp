@@ -1,5 +1,6 @@
-// Ergun drag (docs/verification.md D, seed 003): laminar Kozeny-Carman part plus the inertial
-// (Forchheimer) part, per unit mixture volume (framework/drag.hpp has the convention)
+// Ergun drag (docs/verification.md D; Liang, Zhao & Martinelli, "MPM simulations of the
+// interaction between water jet and soil bed", seed 003): laminar Kozeny-Carman part plus the
+// inertial (Forchheimer) part, per unit mixture volume (framework/drag.hpp has the convention)
 //     Q = n^2 (mu_w / kappa + n rho_w F / sqrt(kappa) |w - v|),
 //     kappa = d^2 n^3 / (A (1 - n)^2)   (Kozeny-Carman, from the CURRENT porosity n),
 //     F = B / (A^(1/2) n^(3/2)).

@@ -81,8 +81,13 @@ class BearingCapacity : public Reference<D> {
     const double q = sum_ / count_, su = params_.real("undrained_strength");
     m["bearing_pressure"] = q;
     m["bearing_ratio"] = q / su;
-    m["bearing_error"] = q / (params_.real("bearing_factor") * su) - 1;
+    m["bearing_factor"] = params_.real("bearing_factor");
+    m["bearing_error"] = q / (m["bearing_factor"] * su) - 1;
     return m;
+  }
+
+  std::vector<Comparison> comparisons(const std::map<std::string, double>&) const override {
+    return {{"bearing_ratio", "bearing_factor", "the bearing_factor given"}};
   }
 
   /// The reactions are complete over the ranks at every step (framework/reactions.hpp).

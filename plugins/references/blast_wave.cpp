@@ -1,4 +1,5 @@
-// Reference: a blast wave leaving a pressurised borehole (seed 002's blasting problem;
+// Reference: a blast wave leaving a pressurised borehole (the blasting problem of "The Material
+// Point Method: A promising computational tool in Geotechnics", seed 002;
 // docs/blast.md, docs/verification.md H). At probe points it records the particle's speed,
 // displacement and stress invariants p, q, and compares the wave's arrival with the P-wave
 // speeds of the layers computed from the materials (c_p = sqrt(M / rho), the speed the time
@@ -157,6 +158,14 @@ class BlastWave : public Reference<D> {
     m["p_wave_speed_body"] = c1_;
     m["p_wave_speed_cover"] = c2_;
     return m;
+  }
+
+  /// Each probe's arrival time against the P-wave's travel time.
+  std::vector<Comparison> comparisons(const std::map<std::string, double>&) const override {
+    std::vector<Comparison> c;
+    for (const auto& pr : probes_)
+      c.push_back({"arrival_time_" + pr.name, "expected_arrival_" + pr.name, "P-wave travel time"});
+    return c;
   }
 
   std::vector<std::pair<std::string, std::vector<double>>> series() const override {

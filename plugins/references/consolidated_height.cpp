@@ -1,8 +1,8 @@
 // Reference: final height of a laterally confined elastic column consolidated under a surface
-// load q (seed 001 large strain, docs/verification.md C "Seed 001 large strain"). Once the excess
-// pore pressure has drained, the effective stress is -q everywhere (no self-weight), and the exact
-// height h = J H0 follows from the stress-strain law along the column axis (nu = 0, M the
-// constrained modulus):
+// load q (the large-strain column of the FEM-and-MPM comparison of large-strain consolidation,
+// seed 001; docs/verification.md C "Seed 001, large strain"). Once the excess pore pressure has
+// drained, the effective stress is -q everywhere (no self-weight), and the exact height h = J H0
+// follows from the stress-strain law along the column axis (nu = 0, M the constrained modulus):
 //   jaumann (hypoelastic, Cauchy stress, Jaumann rate): sigma = M ln J   ->  J = exp(-q / M)
 //   hencky  (hyperelastic, Kirchhoff stress J sigma):   J sigma = M ln J ->  ln J + (q/M) J = 0
 // (q = 50 kPa, M = 100 kPa, H0 = 1 m: 0.60653 m and 0.70347 m). The measured height is the
@@ -59,6 +59,11 @@ class ConsolidatedHeight : public Reference<D> {
       m["height_vs_paper"] = (h - m["paper_height"]) / m["paper_height"];
     }
     return m;
+  }
+
+  std::vector<Comparison> comparisons(const std::map<std::string, double>&) const override {
+    return {{"final_height", "exact_height", "exact"},
+            {"final_height", "paper_height", "the paper"}};
   }
 
   /// The column's sums and largest pore pressure are over the ranks (column.hpp).

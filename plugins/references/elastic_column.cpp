@@ -83,6 +83,10 @@ class ElasticColumn : public Reference<D> {
     return m;
   }
 
+  std::vector<Comparison> comparisons(const std::map<std::string, double>&) const override {
+    return {{"settlement_top_particle", "settlement_exact", "rho g H^2 / (2 M)"}};
+  }
+
   /// The column's integrals are sums over the ranks, its top particle the highest over them.
   bool runs_on_ranks() const override { return true; }
   /// Checkpoints: nothing accumulates; everything is the set-up's or the final state's.

@@ -74,6 +74,11 @@ class GranularCollapse : public Reference<D> {
     return m;
   }
 
+  std::vector<Comparison> comparisons(const std::map<std::string, double>&) const override {
+    return {{"runout_ratio", "lube2005_runout_ratio", "Lube et al. 2005"},
+            {"height_ratio", "lube2005_height_ratio", "Lube et al. 2005"}};
+  }
+
   /// Checkpoints: nothing accumulates; everything is the set-up's or the final state's.
   bool save_state(std::vector<double>&) const override { return true; }
   /// The front, the top and the largest speed are maxima over the ranks.

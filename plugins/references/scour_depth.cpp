@@ -1,5 +1,6 @@
-// Reference: the depth of a scour pit along a vertical jet axis (seed 003, the water jet on a
-// sand bed; docs/verification.md E). It measures: the published result is a trend (the pit
+// Reference: the depth of a scour pit along a vertical jet axis (the water jet on a sand bed of
+// Liang, Zhao & Martinelli, "MPM simulations of the interaction between water jet and soil bed",
+// seed 003; docs/verification.md E). It measures: the published result is a trend (the pit
 // deepens about linearly in the first second, deeper for a faster jet), so the metric is the
 // depth itself, recorded as a time series (verify.series in summary.json and verify.csv).
 //   scour_depth(t) = bed_level - z_top(t),   z_top the highest particle of the bed body inside

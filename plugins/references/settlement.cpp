@@ -1,5 +1,6 @@
 // Reference: final settlement of a laterally confined column under a surface load, for any
-// skeleton material (seed 001 MCC, docs/verification.md C "Seed 001 MCC"). It measures; the value
+// skeleton material (the MCC column after the FEM-and-MPM comparison of large-strain
+// consolidation, seed 001; docs/verification.md C "Seed 001, MCC"). It measures; the value
 // to compare with comes from elsewhere (for an elastoplastic skeleton: the oedometric element test
 // of the same material from the same initial state to the same final vertical effective stress,
 // `loam element-test`, given here as expected_settlement).
@@ -70,6 +71,11 @@ class Settlement : public Reference<D> {
       m["settlement_vs_paper"] = (s - m["paper_settlement"]) / m["paper_settlement"];
     }
     return m;
+  }
+
+  std::vector<Comparison> comparisons(const std::map<std::string, double>&) const override {
+    return {{"final_settlement", "expected_settlement", "expected_settlement"},
+            {"final_settlement", "paper_settlement", "the paper"}};
   }
 
   /// The column's sums and largest pore pressure are over the ranks (column.hpp).

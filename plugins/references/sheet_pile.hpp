@@ -1,6 +1,7 @@
 #pragma once
-// Harr's (1962) head field under a single sheet pile in a half-space (seed 000 piping;
-// docs/verification.md I), shared by the sheet_pile_seepage reference and its tests.
+// Harr's (1962) head field under a single sheet pile in a half-space (the piping of "Numerical
+// Modelling of the Internal Erosion Process in Granular Soils using the Material Point Method",
+// seed 000; docs/verification.md I), shared by the sheet_pile_seepage reference and its tests.
 #include <cmath>
 #include <complex>
 

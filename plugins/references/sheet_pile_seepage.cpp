@@ -1,7 +1,8 @@
-// Reference: seepage under a single impermeable sheet pile and the onset of piping (seed 000;
-// docs/verification.md I). Harr (1962, Groundwater and Seepage, ch. 3, conformal mapping): a
-// pile driven to depth d into a homogeneous layer of infinite depth, the water levels differing
-// by ΔH across it, has the head field
+// Reference: seepage under a single impermeable sheet pile and the onset of piping ("Numerical
+// Modelling of the Internal Erosion Process in Granular Soils using the Material Point Method",
+// seed 000; docs/verification.md I). Harr (1962, Groundwater and Seepage, ch. 3, conformal
+// mapping): a pile driven to depth d into a homogeneous layer of infinite depth, the water levels
+// differing by ΔH across it, has the head field
 //   h(x, y) = h_down + (ΔH / π) Re[arccos(t / d)],   t = ±√(z² + d²),  z = (x - x_pile) + i (y -
 //   y_s)
 // (the sign of t that of x - x_pile: + downstream), so the exit gradient at the downstream
@@ -264,6 +265,10 @@ class SheetPileSeepage : public Reference<D> {
             {"heave", heave_.back()},
             {"fluidised_points", fluidised_.back()},
             {"pipe_fraction", pipe_.back()}};
+  }
+
+  std::vector<Comparison> comparisons(const std::map<std::string, double>&) const override {
+    return {{"critical_head", "critical_head_harr", "Harr 1962"}};
   }
 
   std::vector<std::pair<std::string, std::vector<double>>> series() const override {

@@ -1,7 +1,9 @@
-// Reference: what a slope failure did (seed 004's large-deformation footing, seed 002's slopes;
-// docs/verification.md G). The published results are descriptions and a few numbers (the
-// deposit's top height, the failure's depth and type, when the mass came to rest, the run-out),
-// so the metrics are measurements of the failed mass, printed beside the paper's:
+// Reference: what a slope failure did (the large-deformation footing of the FEM-and-MPM analysis
+// of a hypothetical Mohr-Coulomb slope, seed 004, and the slopes of "The Material Point Method: A
+// promising computational tool in Geotechnics", seed 002; docs/slope_scenes.md). The published
+// results are descriptions and a few numbers (the deposit's top height, the failure's depth and
+// type, when the mass came to rest, the run-out), so the metrics are measurements of the failed
+// mass, printed beside the paper's:
 //   failed mass   the particles of the body whose displacement since the last displacement reset
 //                 (t = 0, or a stage's `reset: [displacement]`, e.g. after the gravity stage)
 //                 exceeds `moved_displacement`;

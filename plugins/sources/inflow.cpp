@@ -1,4 +1,4 @@
-// Inflow of a body's particles through a region at a prescribed velocity: a jet inlet (seed 003,
+// Inflow of a body's particles through a region at a prescribed velocity: a jet inlet (seed 003:
 // Liang, Zhao and Martinelli, "MPM simulations of the interaction between water jet and soil
 // bed": a 2 m square inlet 5 m above the bed, 17-27 m/s), a constant inflow.
 //

@@ -11,10 +11,11 @@
 // is created one spacing behind it (repeatedly, while the gap allows), at the mean velocity of
 // the body's particles in the box. The created mass is counted in the run's mass balance.
 //
-// A rising pool (the upstream side of a sheet pile raised slowly, seed 000): `level` puts the
-// refill face inside the box at t = 0 and `level_rate` moves it outward along its axis at a
-// constant speed, level(t) = level + level_rate t, until it reaches the box's own face, where
-// it stays. The face layer is then the last lattice site at or inside level(t). A
+// A rising pool (the upstream side of a sheet pile raised slowly, as in "Numerical Modelling of
+// the Internal Erosion Process in Granular Soils using the Material Point Method", seed 000):
+// `level` puts the refill face inside the box at t = 0 and `level_rate` moves it outward along its
+// axis at a constant speed, level(t) = level + level_rate t, until it reaches the box's own face,
+// where it stays. The face layer is then the last lattice site at or inside level(t). A
 // `time_function` f >= 0 of the run's time scales the speed: level(t) = level + level_rate
 // int_0^t f dt (TimeFunction::integral: exact for piecewise-linear f), a level that rises in
 // steps, pauses or follows a table of speeds.

@@ -1,5 +1,6 @@
 // A triangular pulse: 0 until `start`, linearly up to `peak` at `peak_time`, linearly down to 0
-// at `end_time`, 0 after (seed 002's blast: 2.5 GPa at 0.017 s, ending at 0.034 s).
+// at `end_time`, 0 after (the blast of "The Material Point Method: A promising computational
+// tool in Geotechnics", seed 002: 2.5 GPa at 0.017 s, ending at 0.034 s).
 #include "framework/registry.hpp"
 #include "framework/time_function.hpp"
 
