@@ -298,6 +298,9 @@ Schema config_schema() {
     s.section_list("probes", p, "time series at a particle or a node, written as CSV");
   }
   s.plugin("verify", "reference", "analytic reference; its error metrics go to summary.json");
+  s.string_list("accept_warnings",
+                "key paths (as a warning prints them, e.g. bodies.0.material.E) whose implausible "
+                "values are meant: their warnings are not shown");
   s.section_list("stages", stage_schema(),
                  "a staged analysis (docs/stages.md): the run goes through these stages in order, "
                  "each applying its changes at its start and ending after its duration or once "
@@ -555,6 +558,21 @@ bool prepare_tree(YAML::Node& root, const std::string& file,
   return true;
 }
 
+/// Drop the warnings of the keys the run file accepts; an accepted key that gets no warning is
+/// itself a warning (a typo in the path, or a value that is plausible after all).
+void accept_warnings(const Params& params, Diagnostics& diag) {
+  if (!params.has("accept_warnings")) return;
+  const std::vector<std::string> accepted = params.strings("accept_warnings");
+  std::vector<std::string> warned;
+  for (const auto& w : diag.warnings()) warned.push_back(w.path);
+  diag.accept_warnings(accepted);
+  for (size_t i = 0; i < accepted.size(); ++i)
+    if (std::find(warned.begin(), warned.end(), accepted[i]) == warned.end())
+      diag.warning(params.where("accept_warnings", i), "accept_warnings." + std::to_string(i),
+                   "'" + accepted[i] + "' has no warning to accept" +
+                       suggest(accepted[i], warned, "keys with warnings are"));
+}
+
 LoadedConfig validate_tree(YAML::Node root, const std::string& file,
                            const std::vector<std::string>& overrides, Diagnostics& diag) {
   LoadedConfig out;
@@ -581,6 +599,7 @@ LoadedConfig validate_tree(YAML::Node root, const std::string& file,
       for (auto& q : p.section->params)
         if (q.key == "stress") q.plugin_components = stress_components(ctx.dimension);
   out.params = validate(root, schema, "", Location{file, 1, 1}, ctx, diag);
+  if (diag.ok()) accept_warnings(out.params, diag);
   return out;
 }
 

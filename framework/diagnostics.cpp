@@ -8,8 +8,8 @@ namespace loam {
 std::string Diagnostic::format() const {
   std::ostringstream s;
   s << (where.file.empty() ? "<input>" : where.file) << ':' << std::max(where.line, 1) << ':'
-    << std::max(where.column, 1) << ": error: " << (path.empty() ? "<document>" : path) << ": "
-    << message;
+    << std::max(where.column, 1) << ": " << severity << ": " << (path.empty() ? "<document>" : path)
+    << ": " << message;
   // One line per error, whatever it quotes: a key or value taken from the file may span lines
   // (a plain YAML scalar continued on the next lines), and its line breaks are shown as \n.
   std::string line;
@@ -24,8 +24,10 @@ void Diagnostics::error(const Location& where, const std::string& path,
   errors_.push_back({where, path, message});
 }
 
-std::string Diagnostics::format() const {
-  std::vector<Diagnostic> sorted = errors_;
+namespace {
+
+/// One line per diagnostic, in file order.
+std::string format_sorted(std::vector<Diagnostic> sorted) {
   std::stable_sort(sorted.begin(), sorted.end(), [](const Diagnostic& a, const Diagnostic& b) {
     if (a.where.file != b.where.file) return a.where.file < b.where.file;
     if (a.where.line != b.where.line) return a.where.line < b.where.line;
@@ -34,6 +36,29 @@ std::string Diagnostics::format() const {
   std::string out;
   for (const auto& e : sorted) out += e.format() + "\n";
   return out;
+}
+
+}  // namespace
+
+std::string Diagnostics::format() const {
+  return format_sorted(errors_);
+}
+
+void Diagnostics::warning(const Location& where, const std::string& path,
+                          const std::string& message) {
+  for (const auto& w : warnings_)
+    if (w.path == path && w.message == message) return;
+  warnings_.push_back({where, path, message, "warning"});
+}
+
+void Diagnostics::accept_warnings(const std::vector<std::string>& accepted) {
+  std::erase_if(warnings_, [&](const Diagnostic& w) {
+    return std::find(accepted.begin(), accepted.end(), w.path) != accepted.end();
+  });
+}
+
+std::string Diagnostics::format_warnings() const {
+  return format_sorted(warnings_);
 }
 
 int edit_distance(const std::string& a, const std::string& b) {

@@ -18,6 +18,7 @@ struct Diagnostic {
   Location where;
   std::string path;
   std::string message;
+  std::string severity = "error";
   std::string format() const;
 };
 
@@ -28,9 +29,17 @@ class Diagnostics {
   const std::vector<Diagnostic>& errors() const { return errors_; }
   /// All errors, one per line, in file order.
   std::string format() const;
+  /// A legal value that is almost surely a slip (ParamSpec::plausible): reported as
+  /// FILE:LINE:COL: warning: key.path: message, and the run goes on.
+  void warning(const Location& where, const std::string& path, const std::string& message);
+  const std::vector<Diagnostic>& warnings() const { return warnings_; }
+  /// Drop the warnings whose key path is in `accepted` (the run file's accept_warnings).
+  void accept_warnings(const std::vector<std::string>& accepted);
+  /// All warnings, one per line, in file order.
+  std::string format_warnings() const;
 
  private:
-  std::vector<Diagnostic> errors_;
+  std::vector<Diagnostic> errors_, warnings_;
 };
 
 /// Thrown after validation when Diagnostics holds errors (exit code 2).

@@ -16,8 +16,11 @@ std::string default_text(const ParamSpec& p) {
 }
 
 std::string constraint_text(const ParamSpec& p) {
-  if (p.has_range()) return "range " + p.range_text();
-  return "";
+  std::string text = p.has_range() ? "range " + p.range_text() : "";
+  if (p.has_plausible())
+    text += (text.empty() ? "" : "; ") + std::string("warns outside [") +
+            format_number(p.plausible_lo) + ", " + format_number(p.plausible_hi) + "]";
+  return text;
 }
 
 void print_schema(std::ostringstream& o, const Schema& s, bool md, const std::string& indent) {
@@ -36,7 +39,7 @@ void print_schema(std::ostringstream& o, const Schema& s, bool md, const std::st
       o << indent << p.key << "  (" << p.type_text();
       if (!p.unit.empty() && p.unit != "-") o << ", " << p.unit;
       o << ", " << default_text(p);
-      if (p.has_range()) o << ", " << constraint_text(p);
+      if (p.has_range() || p.has_plausible()) o << ", " << constraint_text(p);
       o << ")\n" << indent << "    " << p.doc << "\n";
     }
     if (p.section) print_schema(o, *p.section, md, indent + (md ? p.key + "." : "  "));

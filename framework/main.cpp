@@ -158,6 +158,7 @@ int main(int argc, char** argv) {
       fputs(diag.format().c_str(), stderr);
       return 2;
     }
+    fputs(diag.format_warnings().c_str(), stderr);
     auto r = loam::check_config(cfg);
     if (r.exit_code) {
       fputs(r.message.c_str(), stderr);

@@ -53,6 +53,11 @@ struct ParamSpec {
   double lo = -std::numeric_limits<double>::infinity();
   double hi = std::numeric_limits<double>::infinity();
   bool lo_open = false, hi_open = false;
+  /// Plausible values: a legal nonzero value outside [plausible_lo, plausible_hi] is almost
+  /// surely a unit slip and gets a located warning saying `plausible_hint`.
+  double plausible_lo = -std::numeric_limits<double>::infinity();
+  double plausible_hi = std::numeric_limits<double>::infinity();
+  std::string plausible_hint;
   std::vector<std::string> choices;
   int length = kDimension;
   bool broadcast_scalar = false;  // a scalar stands for a vector with equal components
@@ -89,6 +94,13 @@ struct ParamSpec {
     return *this;
   }
   ParamSpec& positive() { return above(0.0); }
+  ParamSpec& plausible(double lo, double hi, std::string hint) {
+    plausible_lo = lo;
+    plausible_hi = hi;
+    plausible_hint = std::move(hint);
+    return *this;
+  }
+  bool has_plausible() const { return !plausible_hint.empty(); }
   ParamSpec& non_negative() { return min(0.0); }
   ParamSpec& len(int n) {
     length = n;

@@ -1107,6 +1107,7 @@ int run_file(const std::string& file, const RunOptions& opt) {
     if (opt.report) fputs(diag.format().c_str(), stderr);
     return 2;
   }
+  if (opt.report && !opt.quiet) fputs(diag.format_warnings().c_str(), stderr);
   RunResult r = run_config(cfg, opt);
   if (!r.message.empty() && opt.report) fputs(r.message.c_str(), stderr);
   return r.exit_code;

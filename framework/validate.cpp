@@ -59,6 +59,19 @@ struct Validator {
     return ok;
   }
 
+  /// A legal nonzero value outside the plausible range (ParamSpec::plausible): a warning.
+  void warn_if_implausible(const ParamSpec& spec, double v, const std::string& path,
+                           const Location& loc) {
+    if (!spec.has_plausible() || v == 0 || (v >= spec.plausible_lo && v <= spec.plausible_hi))
+      return;
+    const std::string unit = spec.unit.empty() || spec.unit == "-" ? "" : " " + spec.unit;
+    diag.warning(loc, path,
+                 format_number(v) + unit + " is outside the plausible [" +
+                     format_number(spec.plausible_lo) + ", " + format_number(spec.plausible_hi) +
+                     "]" + unit + ": " + spec.plausible_hint +
+                     " (list the key under accept_warnings: if it is meant)");
+  }
+
   /// Each element of the sequence n parsed by parse(node, path, location, value); every bad
   /// element is reported. True when all parsed (then `out` holds them in order).
   template <class T, class Parse>
@@ -116,8 +129,9 @@ struct Validator {
     switch (spec.type) {
       case ParamType::Real: {
         double v;
-        if (parse_real(n, path, loc, v) && in_range(spec, v, path, loc)) return v;
-        return {};
+        if (!parse_real(n, path, loc, v) || !in_range(spec, v, path, loc)) return {};
+        warn_if_implausible(spec, v, path, loc);
+        return v;
       }
       case ParamType::Integer: {
         if (n.IsScalar()) {

@@ -47,6 +47,7 @@
 #include "framework/simulation.hpp"
 #include "materials/isotropic_elasticity.hpp"
 #include "materials/mohr_coulomb_return.hpp"
+#include "plausible.hpp"
 
 namespace loam {
 
@@ -83,7 +84,8 @@ class DruckerPrager : public Material<D> {
     s.real("c", "Pa", "cohesion (Mohr-Coulomb's, turned into the cone's by `match`)")
         .required()
         .non_negative();
-    s.real("phi", "deg", "friction angle (Mohr-Coulomb's)").required().min(0).below(90);
+    plausible_angle(
+        s.real("phi", "deg", "friction angle (Mohr-Coulomb's)").required().min(0).below(90));
     add_dilation_angle(s);
     s.choice("match", {"compression", "extension", "plane_strain"},
              "which Mohr-Coulomb states the cone passes through: compression (outer cone, "

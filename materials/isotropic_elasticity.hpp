@@ -1,6 +1,7 @@
 #pragma once
 // The parameters of linear isotropic elasticity shared by several material plugins.
 #include "framework/params.hpp"
+#include "plausible.hpp"
 
 namespace loam {
 
@@ -8,13 +9,13 @@ namespace loam {
 /// (a negative Poisson's ratio is not a soil); general solids allow (-1, 0.5).
 inline Schema isotropic_elastic_schema(bool soil) {
   Schema s;
-  s.real("E", "Pa", "Young's modulus").required().positive();
+  plausible_modulus(s.real("E", "Pa", "Young's modulus").required().positive());
   ParamSpec& nu = s.real("nu", "-", "Poisson's ratio").required().below(0.5);
   if (soil)
     nu.min(0);
   else
     nu.above(-1);
-  s.real("density", "kg/m^3", "mass density").required().positive();
+  plausible_density(s.real("density", "kg/m^3", "mass density").required().positive());
   return s;
 }
 

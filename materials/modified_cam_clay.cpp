@@ -74,6 +74,7 @@
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 #include "framework/tensor.hpp"
+#include "plausible.hpp"
 
 namespace loam {
 
@@ -155,7 +156,7 @@ class ModifiedCamClay : public Material<D> {
            "isotropic overconsolidation ratio: initial p'_c = ocr * p'0, with p'0 each particle's "
            "initial mean effective stress (at least min_pressure) (give pc0 or ocr)")
         .min(1);
-    s.real("density", "kg/m^3", "mass density").required().positive();
+    plausible_density(s.real("density", "kg/m^3", "mass density").required().positive());
     s.real("min_pressure", "Pa",
            "shift of the elastic law: K = v (p' + min_pressure)/kappa, so that a particle at "
            "p' = 0 (free surface, stress-free start) keeps a bulk stiffness; 0 = textbook MCC, "

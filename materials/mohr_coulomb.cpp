@@ -23,6 +23,7 @@
 #include "framework/simulation.hpp"
 #include "materials/isotropic_elasticity.hpp"
 #include "materials/mohr_coulomb_return.hpp"
+#include "plausible.hpp"
 
 namespace loam {
 
@@ -36,7 +37,7 @@ class MohrCoulomb : public Material<D> {
   static Schema schema() {
     Schema s = isotropic_elastic_schema(true);
     s.real("c", "Pa", "cohesion").required().non_negative();
-    s.real("phi", "deg", "friction angle").required().min(0).below(90);
+    plausible_angle(s.real("phi", "deg", "friction angle").required().min(0).below(90));
     add_dilation_angle(s);
     s.real("tension_cutoff", "Pa",
            "largest principal stress (tension positive); default: the Mohr-Coulomb apex "

@@ -39,6 +39,7 @@
 #include "framework/material.hpp"
 #include "framework/params.hpp"
 #include "framework/tensor.hpp"
+#include "plausible.hpp"
 
 namespace loam {
 
@@ -51,10 +52,10 @@ inline double reduced_friction_angle(double phi_deg, double F) {
 /// The dilation angle `psi` (degrees, 0 <= psi < 90) of a frictional model's schema, and the
 /// located error when it exceeds the friction angle `phi` (mohr_coulomb, drucker_prager).
 inline void add_dilation_angle(Schema& s) {
-  s.real("psi", "deg", "dilation angle (non-associated flow; psi <= phi)")
-      .required()
-      .min(0)
-      .below(90);
+  plausible_angle(s.real("psi", "deg", "dilation angle (non-associated flow; psi <= phi)")
+                      .required()
+                      .min(0)
+                      .below(90));
   s.check([](const Params& p, Diagnostics& d) {
     if (p.real("psi") > p.real("phi"))
       d.error(p.where("psi"), p.path("psi"),

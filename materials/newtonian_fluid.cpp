@@ -45,6 +45,7 @@
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 #include "framework/tensor.hpp"
+#include "plausible.hpp"
 
 namespace loam {
 
@@ -63,7 +64,8 @@ class NewtonianFluid : public Material<D> {
     s.real("viscosity", "Pa s", "dynamic viscosity mu (water: 1e-3; 0: inviscid)")
         .required()
         .non_negative();
-    s.real("density", "kg/m^3", "reference density rho0 (p = 0)").required().positive();
+    plausible_density(
+        s.real("density", "kg/m^3", "reference density rho0 (p = 0)").required().positive());
     s.boolean("suspension_viscosity",
               "mu (1 + 2.5 c + 5.2 c^2) with c = 1 - porosity where the particle has a porosity "
               "field (water among grains in the double-point scheme)")

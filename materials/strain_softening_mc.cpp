@@ -58,6 +58,7 @@
 #include "framework/simulation.hpp"
 #include "materials/isotropic_elasticity.hpp"
 #include "materials/mohr_coulomb_return.hpp"
+#include "plausible.hpp"
 
 namespace loam {
 
@@ -74,19 +75,21 @@ class StrainSofteningMC : public Material<D> {
     Schema s = isotropic_elastic_schema(true);
     s.real("c_peak", "Pa", "peak cohesion").required().non_negative();
     s.real("c_residual", "Pa", "residual cohesion (<= c_peak)").required().non_negative();
-    s.real("phi_peak", "deg", "peak friction angle").required().min(0).below(90);
-    s.real("phi_residual", "deg", "residual friction angle (<= phi_peak)")
-        .required()
-        .min(0)
-        .below(90);
-    s.real("psi_peak", "deg", "peak dilation angle (non-associated flow; <= phi_peak)")
-        .required()
-        .min(0)
-        .below(90);
-    s.real("psi_residual", "deg", "residual dilation angle (<= psi_peak, <= phi_residual)")
-        .required()
-        .min(0)
-        .below(90);
+    plausible_angle(s.real("phi_peak", "deg", "peak friction angle").required().min(0).below(90));
+    plausible_angle(s.real("phi_residual", "deg", "residual friction angle (<= phi_peak)")
+                        .required()
+                        .min(0)
+                        .below(90));
+    plausible_angle(
+        s.real("psi_peak", "deg", "peak dilation angle (non-associated flow; <= phi_peak)")
+            .required()
+            .min(0)
+            .below(90));
+    plausible_angle(
+        s.real("psi_residual", "deg", "residual dilation angle (<= psi_peak, <= phi_residual)")
+            .required()
+            .min(0)
+            .below(90));
     s.real("softening_start", "-",
            "equivalent plastic deviatoric strain sqrt(2/3 e:e) where softening begins (peak "
            "strength below it)")
