@@ -11,6 +11,7 @@
 
 #include "particles.hpp"
 #include "registry.hpp"
+#include "stage_repeat.hpp"
 
 namespace loam {
 
@@ -298,13 +299,13 @@ Schema config_schema() {
     s.section_list("probes", p, "time series at a particle or a node, written as CSV");
   }
   s.plugin("verify", "reference", "analytic reference; its error metrics go to summary.json");
-  s.string_list("accept_warnings",
-                "key paths (as a warning prints them, e.g. bodies.0.material.E) whose implausible "
-                "values are meant: their warnings are not shown");
   s.section_list("stages", stage_schema(),
                  "a staged analysis (docs/stages.md): the run goes through these stages in order, "
                  "each applying its changes at its start and ending after its duration or once "
-                 "static; without it the run is one stage of time.end");
+                 "static; without it the run is one stage of time.end. A stage with "
+                 "repeat: {times: N, step: {key.path: increment}} stands for N copies of it, "
+                 "NAME_1 .. NAME_N, each stepped value v + k increment (docs/stages.md, Repeated "
+                 "stages)");
   s.section("strength_reduction", strength_reduction_schema(),
             "a factor of safety by strength reduction after the last stage "
             "(docs/strength_reduction.md): c and tan(phi) divided by F, bisection on F, each "
@@ -352,6 +353,9 @@ Schema config_schema() {
         .def("true");
     s.section("numerics", n, "numerical controls");
   }
+  s.string_list("accept_warnings",
+                "key paths (as a warning prints them, e.g. bodies.0.material.E) whose implausible "
+                "values are meant: their warnings are not shown");
   return s;
 }
 
@@ -558,21 +562,6 @@ bool prepare_tree(YAML::Node& root, const std::string& file,
   return true;
 }
 
-/// Drop the warnings of the keys the run file accepts; an accepted key that gets no warning is
-/// itself a warning (a typo in the path, or a value that is plausible after all).
-void accept_warnings(const Params& params, Diagnostics& diag) {
-  if (!params.has("accept_warnings")) return;
-  const std::vector<std::string> accepted = params.strings("accept_warnings");
-  std::vector<std::string> warned;
-  for (const auto& w : diag.warnings()) warned.push_back(w.path);
-  diag.accept_warnings(accepted);
-  for (size_t i = 0; i < accepted.size(); ++i)
-    if (std::find(warned.begin(), warned.end(), accepted[i]) == warned.end())
-      diag.warning(params.where("accept_warnings", i), "accept_warnings." + std::to_string(i),
-                   "'" + accepted[i] + "' has no warning to accept" +
-                       suggest(accepted[i], warned, "keys with warnings are"));
-}
-
 LoadedConfig validate_tree(YAML::Node root, const std::string& file,
                            const std::vector<std::string>& overrides, Diagnostics& diag) {
   LoadedConfig out;
@@ -591,6 +580,7 @@ LoadedConfig validate_tree(YAML::Node root, const std::string& file,
         location_of(e, "grid.extent", ctx, Location{file, 1, 1}), "grid.extent",
         "the grid needs 1, 2 or 3 components (one per dimension), got " + std::to_string(e.size()));
   }
+  expand_repeated_stages(root, file, diag);
   merge_stage_materials(root);
   Schema schema = config_schema();
   // Stress fields have 3 + D(D-1)/2 components (Voigt, with the out-of-plane normal stress).
@@ -599,7 +589,7 @@ LoadedConfig validate_tree(YAML::Node root, const std::string& file,
       for (auto& q : p.section->params)
         if (q.key == "stress") q.plugin_components = stress_components(ctx.dimension);
   out.params = validate(root, schema, "", Location{file, 1, 1}, ctx, diag);
-  if (diag.ok()) accept_warnings(out.params, diag);
+  out.warnings = diag.warnings();
   return out;
 }
 
@@ -669,6 +659,26 @@ LoadedConfig load_config(const std::string& file, const std::vector<std::string>
     return out;
   }
   return load_config_text(text, file, overrides, diag);
+}
+
+std::string run_warnings(const LoadedConfig& config, const Diagnostics& found) {
+  Diagnostics all;
+  std::vector<std::string> warned;
+  for (const auto* list : {&config.warnings, &found.warnings()})
+    for (const Diagnostic& w : *list) {
+      all.warning(w.where, w.path, w.message);
+      warned.push_back(w.path);
+    }
+  const Params& p = config.params;
+  if (!p.has("accept_warnings")) return all.format_warnings();
+  const std::vector<std::string>& accepted = p.strings("accept_warnings");
+  all.accept_warnings(accepted);
+  for (size_t i = 0; i < accepted.size(); ++i)
+    if (std::find(warned.begin(), warned.end(), accepted[i]) == warned.end())
+      all.warning(p.where("accept_warnings", i), "accept_warnings." + std::to_string(i),
+                  "'" + accepted[i] + "' has no warning to accept" +
+                      suggest(accepted[i], warned, "keys with warnings are"));
+  return all.format_warnings();
 }
 
 }  // namespace loam

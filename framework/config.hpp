@@ -17,7 +17,15 @@ struct LoadedConfig {
   int dimension = 0;
   std::string file;
   std::string name;  // file stem, for the default output directory
+  /// The validation's plausibility warnings (ParamSpec::plausible), before accept_warnings:
+  /// the run adds its own (the step budget) and prints them all (run_warnings).
+  std::vector<Diagnostic> warnings;
 };
+
+/// The warnings of a run, `found` and the config's, less those its accept_warnings lists, as
+/// located lines; a listed key without a warning is itself a warning (a typo in the path, or a
+/// value that is plausible after all).
+std::string run_warnings(const LoadedConfig& config, const Diagnostics& found);
 
 /// Read, override, validate. On any error, diag holds every message and the result is unusable.
 LoadedConfig load_config(const std::string& file, const std::vector<std::string>& overrides,

@@ -158,12 +158,12 @@ int main(int argc, char** argv) {
       fputs(diag.format().c_str(), stderr);
       return 2;
     }
-    fputs(diag.format_warnings().c_str(), stderr);
     auto r = loam::check_config(cfg);
     if (r.exit_code) {
       fputs(r.message.c_str(), stderr);
       return r.exit_code;
     }
+    fputs(r.warnings.c_str(), stderr);
     std::printf("%s: ok (%dD, %zu particles, %zu cells)\n", check_file.c_str(), cfg.dimension,
                 r.summary["particles"].get<size_t>(), r.summary["cells"].get<size_t>());
     return 0;

@@ -121,10 +121,12 @@ RunResult Run<D>::execute(bool check_only) {
     res.message = diag.format();
     return res;
   }
+  res.warnings = run_warnings(cfg_, diag);
   if (check_only) {
     res.summary = base_summary();
     return res;
   }
+  if (opt_.report && !opt_.quiet && sim_->ranks->root()) fputs(res.warnings.c_str(), stderr);
   const Params& output = cfg_.params.section("output");
   if (output.has("checkpoint") && (output.section("checkpoint").has("every_steps") ||
                                    output.section("checkpoint").has("every_wall_seconds"))) {
@@ -1107,7 +1109,6 @@ int run_file(const std::string& file, const RunOptions& opt) {
     if (opt.report) fputs(diag.format().c_str(), stderr);
     return 2;
   }
-  if (opt.report && !opt.quiet) fputs(diag.format_warnings().c_str(), stderr);
   RunResult r = run_config(cfg, opt);
   if (!r.message.empty() && opt.report) fputs(r.message.c_str(), stderr);
   return r.exit_code;

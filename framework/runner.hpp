@@ -29,7 +29,8 @@ struct RunOptions {
 struct RunResult {
   int exit_code = 0;
   nlohmann::json summary;
-  std::string message;  // errors to print (already formatted)
+  std::string message;   // errors to print (already formatted)
+  std::string warnings;  // warnings to print (run_warnings), when the model was built
 };
 
 /// Validate and run a file; prints diagnostics and progress. Returns the exit code.

@@ -14,6 +14,10 @@ namespace loam {
 
 namespace {
 
+/// More steps than this at the first stable time step is almost surely a unit slip (a warning;
+/// time.max_steps is the hard limit): 1e7 steps of a 10^4-particle model take hours.
+constexpr double kPlausibleSteps = 1e7;
+
 /// A face a periodic condition joins to its opposite (Boundary::periodic_axis) must not be held
 /// by another condition of the same list: the particles would both wrap and stop there.
 template <int D>
@@ -179,6 +183,14 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
                    " steps, more than time.max_steps = " + std::to_string(max_steps) +
                    " (a stiff material or pore fluid, e.g. K_w / n with a tiny porosity, or a "
                    "fine grid); raise time.max_steps if this is intended");
+  else if (end_time / dt0 > kPlausibleSteps)
+    diag.warning(t.where("end"), t.path("end"),
+                 "the stable time step at the start is " + format_number(dt0) + " s, so " +
+                     format_number(end_time) + " s needs about " +
+                     format_number(std::ceil(end_time / dt0)) +
+                     " steps: a modulus or bulk modulus in Pa meant in kPa, a density in t/m^3, "
+                     "or cells smaller than meant? (list time.end under accept_warnings: if it "
+                     "is meant)");
 }
 
 template <int D>

@@ -110,7 +110,7 @@ void require_rejected(const Scratch& s, const Outcome& r, const std::vector<std:
 const std::string kTopKeys =
     "plugins, grid, shape_function, scheme, gravity, bodies, selections, boundaries, loads, "
     "sources, sinks, damping, contact, time, output, probes, verify, stages, strength_reduction, "
-    "numerics";
+    "numerics, accept_warnings";
 
 }  // namespace
 

@@ -7,6 +7,7 @@
 
 #include "cli.hpp"
 #include "framework/config.hpp"
+#include "framework/runner.hpp"
 
 using Catch::Matchers::Contains;
 
@@ -25,10 +26,11 @@ std::string sand_column(const std::string& material, const std::string& extra = 
          extra;
 }
 
-loam_test::CliResult check(const loam_test::TempDir& dir, const std::string& yaml) {
+loam_test::CliResult check(const loam_test::TempDir& dir, const std::string& yaml,
+                           const std::string& args = "") {
   std::filesystem::create_directories(dir.path);
   std::ofstream(dir.path / "run.yaml") << yaml;
-  return loam_test::run_loam("check " + (dir.path / "run.yaml").string());
+  return loam_test::run_loam("check " + (dir.path / "run.yaml").string() + " " + args);
 }
 
 }  // namespace
@@ -77,7 +79,7 @@ TEST_CASE("plausibility: accept_warnings silences each key, and names a key with
                                 "'bodies.0.material.phi' has no warning to accept"));
 }
 
-TEST_CASE("plausibility: an invalid run file prints its errors only; --quiet runs print none",
+TEST_CASE("plausibility: an invalid run file prints its errors only, a --quiet run none",
           "[config][cli]") {
   loam_test::TempDir dir("plausible_errors");
   std::filesystem::create_directories(dir.path);
@@ -99,16 +101,34 @@ TEST_CASE("plausibility: an invalid run file prints its errors only; --quiet run
   CHECK_THAT(r.output, Contains("warning: bodies.0.material.density"));
 }
 
+TEST_CASE("plausibility: a run that would need more than 1e7 steps warns", "[config][cli]") {
+  // The sand column's stable step is about 8e-4 s (0.1 m cells, p-wave about 60 m/s): 1e4 s
+  // needs about 1.2e7 steps, below time.max_steps (1e8, an error) but above 1e7.
+  loam_test::TempDir dir("plausible_steps");
+  const std::string sand = sand_column("E: 5.0e6, density: 1800, phi: 30");
+  auto r = check(dir, sand, "--set time.end=1e4");
+  std::printf("%s", r.output.c_str());
+  CHECK(r.exit_code == 0);
+  CHECK_THAT(r.output, Contains("warning: time.end: the stable time step at the start is"));
+  r = check(dir, sand + "accept_warnings: [time.end]\n", "--set time.end=1e4");
+  CHECK(r.exit_code == 0);
+  CHECK_THAT(r.output, !Contains("warning"));
+  r = check(dir, sand);  // 0.01 s: nothing to say
+  CHECK_THAT(r.output, !Contains("warning"));
+}
+
 TEST_CASE("plausibility: no shipped run file warns", "[config][unit]") {
   int files = 0;
   for (const auto& e :
        std::filesystem::directory_iterator(std::string(LOAM_SOURCE_DIR) + "/configs")) {
     if (e.path().extension() != ".yaml") continue;
     loam::Diagnostics diag;
-    loam::load_config(e.path().string(), {}, diag);
-    INFO(e.path().string() << "\n" << diag.format() << diag.format_warnings());
-    CHECK(diag.ok());
-    CHECK(diag.warnings().empty());
+    const loam::LoadedConfig cfg = loam::load_config(e.path().string(), {}, diag);
+    REQUIRE(diag.ok());
+    const loam::RunResult r = loam::check_config(cfg);
+    INFO(e.path().string() << "\n" << r.message << r.warnings);
+    CHECK(r.exit_code == 0);
+    CHECK(r.warnings.empty());
     ++files;
   }
   std::printf("%d shipped run files: no warnings\n", files);

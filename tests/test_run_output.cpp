@@ -86,7 +86,8 @@ TEST_CASE("loam check validates without writing, plugins lists every kind", "[ou
   for (const char* kind : {"shape_function", "material", "scheme", "boundary", "load", "damping",
                            "reference", "writer"})
     CHECK(p.output.find(std::string(kind) + " — ") != std::string::npos);
-  CHECK(p.output.find("E  (real, Pa, required, range (0, inf))") != std::string::npos);
+  CHECK(p.output.find("E  (real, Pa, required, range (0, inf); warns outside [1000, ") !=
+        std::string::npos);
   auto bad = run_loam("plugins materail");
   CHECK(bad.exit_code == 2);
   CHECK(bad.output.find("did you mean 'material'?") != std::string::npos);

@@ -877,6 +877,17 @@ TEST_CASE("vibrating bar with gimp and bspline2 through the CLI: period and ener
   }
 }
 
+/// A 1D bar filling a grid of `cells` unit cells with `ppc` particles per cell.
+static std::unique_ptr<loam::Simulation<1>> filled_bar(const char* shape, int cells, int ppc) {
+  const std::string n = std::to_string(cells);
+  return make_simulation<1>("grid: {origin: [0], extent: [" + n +
+                            "], cell_size: 1}\nshape_function: " + shape +
+                            "\nbodies:\n  - {name: b, generator: {type: box, min: [0], max: [" + n +
+                            "]}, particles_per_cell: " + std::to_string(ppc) +
+                            ", material: {type: linear_elastic, E: 1, nu: 0, density: 1}}\n"
+                            "time: {end: 1}\n");
+}
+
 /// sum_p w_p N_i(x_p) at each node of a 1D simulation's grid over the particles of its first set.
 static std::vector<double> weighted_node_sums(loam::Simulation<1>& sim,
                                               const std::vector<double>& weight) {
@@ -912,14 +923,7 @@ TEST_CASE("every shape function: axis_node_volume is the integral of the node's 
     for (int cells : {1, 2, 3, 6})
       for (int ppc : {2, 3}) {
         if (point && ppc == 3) continue;
-        auto sim = make_simulation<1>("grid: {origin: [0], extent: [" + std::to_string(cells) +
-                                      "], cell_size: 1}\nshape_function: " + sf +
-                                      "\nbodies:\n  - {name: b, generator: {type: box, min: [0], "
-                                      "max: [" +
-                                      std::to_string(cells) +
-                                      "]}, particles_per_cell: " + std::to_string(ppc) +
-                                      ", material: {type: linear_elastic, E: 1, nu: 0, density: "
-                                      "1}}\ntime: {end: 1}\n");
+        auto sim = filled_bar(sf, cells, ppc);
         auto& P = sim->sets[0].particles;
         std::vector<double> weight;  // quadrature weight of each particle
         if (point) {
@@ -957,14 +961,7 @@ TEST_CASE("every shape function: axis_node_lattice_volume is what the generated 
   for (const char* sf : {"linear", "bspline2", "gimp", "cpdi"})
     for (int cells : {1, 2, 3, 6})
       for (int ppc : {1, 2, 3, 4}) {
-        auto sim = make_simulation<1>("grid: {origin: [0], extent: [" + std::to_string(cells) +
-                                      "], cell_size: 1}\nshape_function: " + sf +
-                                      "\nbodies:\n  - {name: b, generator: {type: box, min: [0], "
-                                      "max: [" +
-                                      std::to_string(cells) +
-                                      "]}, particles_per_cell: " + std::to_string(ppc) +
-                                      ", material: {type: linear_elastic, E: 1, nu: 0, density: "
-                                      "1}}\ntime: {end: 1}\n");
+        auto sim = filled_bar(sf, cells, ppc);
         const auto& P = sim->sets[0].particles;
         REQUIRE(P.size() == size_t(cells * ppc));
         const std::vector<double> V =
