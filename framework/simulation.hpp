@@ -223,8 +223,11 @@ class Simulation {
   /// Exchange the last good state with the current one (twice: back).
   void swap_last_good();
   /// The material stress update of one block [b, b + count) (one material per block), with
-  /// its velocity gradient L in block layout (MaterialBatch).
-  void update_block_stress(ParticleSet<D>& set, size_t b, int count, double dt, const double* L) {
+  /// its velocity gradient L in block layout (MaterialBatch). The energy ledger counts the
+  /// stress power V sigma : L, or V sigma : L_power where a scheme changes the volume otherwise
+  /// than tr L (the double-point liquid: its storage equation).
+  void update_block_stress(ParticleSet<D>& set, size_t b, int count, double dt, const double* L,
+                           const double* L_power = nullptr) {
     MaterialBatch<D> batch;
     batch.begin = b;
     batch.count = count;
@@ -232,10 +235,11 @@ class Simulation {
     batch.L = L;
     batch.particles = &set.particles;
     if (!ledger.enabled) return materials[set.particles.material[b]]->update_stress(batch);
-    const double before = block_stress_power(set.particles, b, count, L);
+    const double* Lp = L_power ? L_power : L;
+    const double before = block_stress_power(set.particles, b, count, Lp);
     materials[set.particles.material[b]]->update_stress(batch);
-    ledger.add_stress_work(set_slot(set), b, before, block_stress_power(set.particles, b, count, L),
-                           dt);
+    ledger.add_stress_work(set_slot(set), b, before,
+                           block_stress_power(set.particles, b, count, Lp), dt);
   }
   /// The index of `set` in sets.
   size_t set_slot(const ParticleSet<D>& set) const { return size_t(&set - sets.data()); }

@@ -83,6 +83,26 @@ void follow_held_phases(double* records, const TwoPhaseRecord& k, const double* 
   });
 }
 
+/// The drag's dissipation Q |w' - v'|^2 dt of every node with both phases, with the velocities
+/// the boundary conditions left: a fixed base holds both phases, and the relative velocity of
+/// the unconstrained solve there is not a flow (it is the base's reaction).
+template <int D>
+void count_drag_dissipation(Simulation<D>& sim, const double* records, const TwoPhaseRecord& k,
+                            double dt) {
+  const double tol = sim.mass_tolerance;
+  for_each_node(sim.grid.num_nodes, sim.threads, [&](size_t i) {
+    const double* r = records + i * size_t(k.stride);
+    const double Q = r[k.drag];
+    if (r[k.solid_mass] <= tol || r[k.water_mass] <= tol || !(Q > 0)) return;
+    double slip2 = 0;
+    for (int d = 0; d < D; ++d) {
+      const double s = r[k.water_velocity + d] - r[k.solid_velocity + d];
+      slip2 += s * s;
+    }
+    sim.ledger.add_drag(i, dt * Q * slip2);
+  });
+}
+
 /// The boundary conditions on both phases of the records after the coupled solve
 /// (Simulation::constrain_update, with the nodal masses and porosity), then the re-solve of a
 /// free phase against a held partner (follow_held_phases).
@@ -104,6 +124,7 @@ void constrain_two_phase_update(Simulation<D>& sim, double* records, const TwoPh
     follow_held_phases<D>(records, k, solved, sim.grid.num_nodes, sim.threads, sim.mass_tolerance,
                           dt);
   });
+  if (sim.ledger.enabled) count_drag_dissipation(sim, records, k, dt);
 }
 
 /// Square of the fastest wave speed of the undamped (drag-free) two-phase equations: the largest

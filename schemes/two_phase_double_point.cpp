@@ -237,7 +237,10 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     cell_solid_.assign(sim.grid.num_cells, 0.0);
     for (const auto& m : sim.materials) inv_density_.push_back(1 / m->density());
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
-                                           [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
+                                           [](Scratch& s) {
+                                             s.Q.assign(size_t(kBlock), 0.0);
+                                             s.L_power.assign(size_t(D * D * kBlock), 0.0);
+                                           });
     initialize_particles(sim, sim.sets[kSolid], 0, sim.sets[kSolid].size());
     if (affine_on_) setup_apic(sim, diag);
     if (diag.ok()) fill_pores(sim);
@@ -365,6 +368,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     F_ = sim.deformation_gradient;  // may be requested after our set-up
     for (int s = 0; s < 2; ++s) move_[s].resize(sim.sets[size_t(s)].size() * D);
     lw_.resize(sim.sets[kLiquid].size() * D * D);
+    volume_rate_.resize(sim.sets[kLiquid].size());
     with_stencil_size<D>(sim.shape->nodes_per_particle(),
                          [&](auto npp) { step_phases<decltype(npp)::value>(sim, dt); });
   }
@@ -401,7 +405,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   std::vector<double> cell_liquid_;  // per grid cell: liquid volume sum V at the step's start
   std::vector<size_t> liquid_cell_;  // per liquid point: its cell at the step's start
   double inv_cell_volume_ = 1;
-  std::vector<double> lw_;   // per liquid point: L_w (D * D values) until its stress update
+  std::vector<double> lw_;           // per liquid point: L_w (D * D values) until its stress update
+  std::vector<double> volume_rate_;  // per liquid point: the step's applied rate (V' - V)/(V dt)
   CellProjection<D> cells_;  // per grid cell: liquid volume and mass, the density's projection
   bool smooth_ = true;
   double n_max_;  // fluidisation threshold (2: never)
@@ -413,9 +418,10 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   bool zero_surface_pressure_;
   std::vector<double> mixture_force_;  // per node (D values), while boundary forces are added
   struct Scratch : BlockScratch<D> {
-    std::vector<double> Q;   // drag coefficients of the block
-    long bad_porosity = -1;  // a solid point whose porosity left (0, 1) this step
-    long bad_volume = -1;    // a liquid point compressed to zero volume this step
+    std::vector<double> Q;        // drag coefficients of the block
+    std::vector<double> L_power;  // the liquid's velocity gradient for the energy ledger
+    long bad_porosity = -1;       // a solid point whose porosity left (0, 1) this step
+    long bad_volume = -1;         // a liquid point compressed to zero volume this step
   };
   std::vector<std::unique_ptr<Scratch>> scratch_;
 
@@ -872,7 +878,6 @@ class TwoPhaseDoublePoint : public Scheme<D> {
         if (has_s && has_w) {
           const auto s = solve_drag_implicit(ms, mw, Q, dt, ms * v / dt + Fs, mw * w / dt + Fw);
           vn = s.solid, wn = s.water;
-          if (sim.ledger.enabled) sim.ledger.add_drag(i, dt * Q * (wn - vn) * (wn - vn));
         } else if (has_s) {
           vn = v + dt * Fs / ms;
         } else if (has_w) {
@@ -1122,6 +1127,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       // n: the step's, from the scatter; the water's share of a compression of the pores
       const double share = water_share(saturation);
       const double factor = 1 + dt * (share == 1 || rate > 0 ? rate : share * rate) / P.col(n_)[i];
+      volume_rate_[i] = (factor - 1) / dt;
       P.col(P.volume)[i] *= factor;
       if (!(factor > 0)) sc.bad_volume = long(i);
     }
@@ -1186,8 +1192,25 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     for (int p = 0; p < count; ++p)
       for (int a = 0; a < D * D; ++a)
         L[size_t(a) * kBlock + size_t(p)] = lw_[(b + size_t(p)) * D * D + size_t(a)];
-    sim.update_block_stress(set, b, count, dt, L);
+    const double* Lp = sim.ledger.enabled ? stress_power_gradient(L, b, count, thread) : nullptr;
+    sim.update_block_stress(set, b, count, dt, L, Lp);
     water_pressure(P, b, b + size_t(count));
+  }
+
+  /// The gradient whose stress power the ledger counts for liquid points [b, b + count): the
+  /// volume followed the storage equation, not tr L_w, so the trace is the applied rate (the
+  /// pressure's work on both phases, p V rate); the deviatoric part is L_w's.
+  const double* stress_power_gradient(const double* L, size_t b, int count, int thread) {
+    double* Lp = scratch_[size_t(thread)]->L_power.data();
+    for (int p = 0; p < count; ++p) {
+      double tr = 0;
+      for (int d = 0; d < D; ++d) tr += L[size_t(d * D + d) * kBlock + size_t(p)];
+      const double shift = (volume_rate_[b + size_t(p)] - tr) / D;
+      for (int a = 0; a < D * D; ++a)
+        Lp[size_t(a) * kBlock + size_t(p)] =
+            L[size_t(a) * kBlock + size_t(p)] + (a % (D + 1) == 0 ? shift : 0.0);
+    }
+    return Lp;
   }
 
   /// The pore_pressure field of liquid points [b, e): -tr(sigma_w)/3.

@@ -561,7 +561,6 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         r[kW + d] = solved[D + d] = wn;
         r[kF + d] = (vn - v) / dt;
         r[kFw + d] = (wn - w) / dt;
-        if (sim.ledger.enabled) sim.ledger.add_drag(i, dt * Q * (wn - vn) * (wn - vn));
       }
     });
   }

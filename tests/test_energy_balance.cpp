@@ -226,3 +226,45 @@ TEST_CASE("energy balance: the drag dissipates what consolidation takes from the
   CHECK(drag > 0.4 * w);
   CHECK(rel <= 0.01);
 }
+
+TEST_CASE("energy balance: the double-point liquid's pressure work and the drag at held nodes",
+          "[energy][two_phase]") {
+  // Reference: as the single-point Terzaghi column (configs/terzaghi_double_point.yaml, the same
+  // column with solid and liquid points): W_loads = E_strain + D_drag + D_material. The liquid
+  // points' stress power is p V times the storage equation's volume rate (the pressure's work on
+  // both phases), and the drag dissipates Q |w - v|^2 with the velocities the conditions left
+  // (none at the fixed base). Tolerance 1 % of the largest term; the hydrostatic column's drag
+  // must be round-off (water at rest over a fixed base).
+  const fs::path dir = fs::temp_directory_path() / "loam_energy_terzaghi_dp";
+  const auto r =
+      loam_test::run_loam("run " + std::string(LOAM_SOURCE_DIR) +
+                          "/configs/terzaghi_double_point.yaml --quiet --overwrite --out " +
+                          dir.string() + " --threads 1 --set output.energy_balance=true");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  const auto h = loam_test::read_csv_columns(dir / "history.csv");
+  const double w = h.at("work_loads").back(), drag = h.at("dissipation_drag").back();
+  const double rel = worst_balance(h);
+  std::printf(
+      "Terzaghi column, double point: W_loads %.3f J, E_strain %.3f J, D_drag %.3f J, "
+      "D_material %.4f J, largest |balance| %.3f %%\n",
+      w, h.at("strain_energy").back(), drag, h.at("dissipation_material").back(), 100 * rel);
+  CHECK(drag > 0.4 * w);
+  CHECK(std::fabs(h.at("dissipation_material").back()) < 0.01 * w);
+  CHECK(rel <= 0.01);
+
+  const fs::path still = fs::temp_directory_path() / "loam_energy_hydrostatic_dp";
+  const auto s = loam_test::run_loam(
+      "run " + std::string(LOAM_SOURCE_DIR) +
+      "/configs/hydrostatic_double_point.yaml --quiet --overwrite --out " + still.string() +
+      " --threads 1 --set output.energy_balance=true --set time.end=0.2");
+  INFO(s.output);
+  REQUIRE(s.exit_code == 0);
+  const auto hs = loam_test::read_csv_columns(still / "history.csv");
+  const double e = hs.at("strain_energy").back();
+  std::printf(
+      "hydrostatic double point: D_drag %.3g J, largest |balance| %.3g of E_strain %.3f J\n",
+      hs.at("dissipation_drag").back(), worst_balance(hs), e);
+  CHECK(std::fabs(hs.at("dissipation_drag").back()) < 1e-6 * e);  // 0.027 J counting the base
+  CHECK(worst_balance(hs) < 1e-6);
+}
