@@ -1,4 +1,4 @@
-// The `loam` command line: run, check, element-test, plugins, schema, compare, bench.
+// The `loam` command line: run, check, element-test, plot, plugins, schema, compare, bench.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -10,6 +10,7 @@
 #include "docs.hpp"
 #include "element_test.hpp"
 #include "launch.hpp"
+#include "plot.hpp"
 #include "runner.hpp"
 #ifdef LOAM_WITH_MPI
 #include "mpi/mpi_ranks.hpp"
@@ -58,6 +59,17 @@ int main(int argc, char** argv) {
   element->add_option("--out", et_opt.out_dir, "output directory (default results/<file name>)");
   element->add_flag("--overwrite", et_opt.overwrite, "replace the results in the directory");
   element->add_flag("--quiet", et_opt.quiet, "no progress lines");
+
+  loam::PlotOptions plot_opt;
+  auto* plot = app.add_subcommand(
+      "plot", "draw a run: a frame's particles coloured by a field, its history and verify series");
+  plot->add_option("run", plot_opt.run_dir, "the run's output directory")->required();
+  plot->add_option("--field", plot_opt.field,
+                   "particle field (default: plastic_strain_eq, pore_pressure, displacement, "
+                   "velocity or stress, the first the frame has); NAME:K one component");
+  plot->add_option("--frame", plot_opt.frame, "frame index (0 the first; default -1, the last)");
+  plot->add_option("--set", plot_opt.set, "one particle set (default: all)");
+  plot->add_option("--out", plot_opt.out, "PNG file (default RUN/plot.png)");
 
   std::string kind;
   bool markdown = false;
@@ -182,6 +194,7 @@ int main(int argc, char** argv) {
     if (et_opt.quiet) spdlog::set_level(spdlog::level::warn);
     return loam::run_element_test_file(et_file, et_opt);
   }
+  if (*plot) return loam::run_plot(plot_opt);
   if (*bench) return loam::run_bench(bench_opt);
   if (*compare) return loam::run_compare(cmp_opt);
   return 0;

@@ -6,7 +6,8 @@ Usage: terzaghi_plot.py RUN_DIR --cv 1.0194 --H 1 --p0 1e4 [--T 0.05 0.1 0.2 0.5
 The vertical axis is the last coordinate; depth is measured from the initial top of the column."""
 import argparse
 import math
-import re
+
+from loam_plot import frames_of_set
 
 
 def terzaghi(zr, T):
@@ -24,10 +25,9 @@ def terzaghi(zr, T):
 
 
 def frames(run_dir):
-    """(time, path) of every particle frame of a run, from its ParaView index particles.xdmf."""
-    xdmf = open(run_dir + "/particles.xdmf").read()
-    found = re.findall(r'<Time Value="([^"]+)"/>.*?(particles_\d+\w*\.h5):/position', xdmf, re.S)
-    return [(float(t), run_dir + "/" + f) for t, f in found]
+    """(time, path) of every particle frame of a run (loam_plot.frames_of_set reads the ParaView
+    index; a frame split over ranks by its first file)."""
+    return [(t, files[0]) for t, files in frames_of_set(run_dir + "/particles.xdmf")]
 
 
 def main():
