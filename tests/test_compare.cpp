@@ -132,3 +132,75 @@ TEST_CASE("loam compare stops cleanly on SIGINT and the same command resumes the
   CHECK(rows[1][status] == "ok");
   CHECK(rows[2][status] == "ok");
 }
+
+TEST_CASE("loam compare: the sweep's own metrics, failed variants marked, honest plot messages",
+          "[compare]") {
+  TempDir dir("compare_metrics");
+  std::filesystem::create_directories(dir.path);
+  const auto sweep = dir.path / "sweep.yaml";
+  // The vibrating bar's kinetic energy starts at its largest, the initial energy 1/2 m v0^2
+  // (docs/verification.md, vibrating bar): 0.0625 J is the reference of `peak_kinetic`.
+  std::ofstream(sweep) << "base: " << LOAM_SOURCE_DIR << "/configs/vibrating_bar.yaml\n"
+                       << "set: [time.end=5]\n"
+                       << "axes:\n  time.dt: [0.01, 1.0]\n"  // 1.0 s is far above the CFL limit
+                       << "metrics:\n"
+                       << "  - {name: peak_kinetic, column: kinetic_energy, of: max, "
+                          "reference: 0.0625}\n"
+                       << "  - {name: final_reaction, column: no_such_column, of: final}\n"
+                       << "metric: peak_kinetic_error\nthreads: 1\n";
+  const auto out = dir.path / "out";
+  auto r = run_loam("compare " + sweep.string() + " --out " + out.string());
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  auto rows = read_csv(out / "compare.csv");
+  REQUIRE(rows.size() == 3);
+  const auto& h = rows[0];
+  auto col = [&](const std::string& name) {
+    return size_t(std::find(h.begin(), h.end(), name) - h.begin());
+  };
+  REQUIRE(col("peak_kinetic_error") < h.size());
+  const auto& ok = rows[1];
+  CHECK(ok[col("status")] == "ok");
+  const double peak = std::stod(ok[col("peak_kinetic")]);
+  std::printf("peak kinetic energy %.6g J (reference 0.0625 J), relative error %.3g\n", peak,
+              std::stod(ok[col("peak_kinetic_error")]));
+  CHECK(std::fabs(peak / 0.0625 - 1) < 0.02);
+  CHECK(std::stod(ok[col("peak_kinetic_error")]) == Approx(peak / 0.0625 - 1).margin(1e-12));
+  CHECK_THAT(ok[col("message")],
+             Catch::Matchers::Contains("metric final_reaction: no column no_such_column"));
+  CHECK(rows[2][col("status")] == "unstable");
+  // The unstable variant is named as not plotted, its message whole (not cut).
+  CHECK_THAT(r.output, Catch::Matchers::Contains("not plotted, marked in red: "
+                                                 "time.dt=1.0 (unstable)"));
+  CHECK_THAT(r.output, Catch::Matchers::Contains("unstable run at step"));
+  CHECK(std::filesystem::exists(out / "pareto.png"));
+
+  // A metric that no variant has: located, and the columns there are.
+  std::string text = loam_test::slurp(sweep);
+  text.replace(text.find("metric: peak_kinetic_error"), 26, "metric: peak_kinetik");
+  std::ofstream(sweep) << text;
+  auto bad = run_loam("compare " + sweep.string() + " --out " + out.string());
+  CHECK(bad.exit_code == 0);
+  CHECK_THAT(bad.output, Catch::Matchers::Contains(
+                             "pareto.png not written: " + sweep.string() +
+                             ":8:9: metric: 'peak_kinetik' is not a metric of any variant ("));
+  CHECK_THAT(bad.output, Catch::Matchers::Contains("peak_kinetic_error"));
+  CHECK(bad.output.find("--metric") == std::string::npos);
+  CHECK(bad.output.find("matplotlib") == std::string::npos);
+}
+
+TEST_CASE("loam compare without any error metric says how to name one", "[compare]") {
+  TempDir dir("compare_no_metric");
+  std::filesystem::create_directories(dir.path);
+  const auto sweep = dir.path / "sweep.yaml";
+  std::ofstream(sweep) << "base: " << LOAM_SOURCE_DIR << "/configs/quickstart.yaml\n"
+                       << "set: [time.end=0.01]\naxes:\n  shape_function: [linear]\nthreads: 1\n";
+  auto r = run_loam("compare " + sweep.string() + " --out " + (dir.path / "out").string());
+  INFO(r.output);
+  CHECK(r.exit_code == 0);
+  CHECK_THAT(r.output, Catch::Matchers::Contains(
+                           "pareto.png not written: no metric named *error* (the variants have "
+                           "none): name the column to plot with `metric:` in " +
+                           sweep.string() + ", or define one under `metrics:` with a `reference`"));
+  CHECK(r.output.find("--metric") == std::string::npos);
+}
