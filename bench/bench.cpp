@@ -181,6 +181,7 @@ int run_scene(const BenchOptions& opt, const std::string& scene, const std::stri
         RunOptions ro;
         ro.threads = threads;
         ro.quiet = true;
+        ro.report = false;  // the benchmark prints its own lines (--json: only JSON)
         ro.write_output = false;
         ro.max_steps = 20;  // warm-up: first sorts, page faults, caches
         ro.profile = opt.profile;

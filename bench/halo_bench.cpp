@@ -1,4 +1,4 @@
-// The halo exchange's cost per step (issue 18; bench/RESULTS.md): under mpirun, the 2D and 3D
+// The halo exchange's cost per step (bench/RESULTS.md, docs/parallel.md): under mpirun, the 2D and 3D
 // blocks of `loam bench` (160 x 176 cells, 24 x 24 x 24 cells), decomposed over the launched
 // ranks with a ghost layer of gimp/bspline2 (rows 1 below, 2 above), and the exchanges one
 // single-phase MUSL step makes: reverse and forward of the nodal record (mass, momentum, force:

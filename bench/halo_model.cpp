@@ -1,4 +1,4 @@
-// The weak-scaling model of the halo exchange (issue 18; bench/RESULTS.md): for a rank array of
+// The weak-scaling model of the halo exchange (bench/RESULTS.md, docs/parallel.md): for a rank array of
 // 2 to 64 ranks, each rank holding the `loam bench` block (2D: 160 x 176 cells, 102 400
 // particles; 3D: 24 x 24 x 22 filled of 24^3 cells, 101 376 particles), the busiest rank's halo
 // per single-phase MUSL step from the real decomposition (framework/decomposition.hpp; gimp's

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Soak benchmark (issue 14, deliverable 7; not a test): a run of 10^6 steps must hold its memory
+# Soak benchmark (not a test): a run of 10^6 steps must hold its memory
 # flat (resident set size near the start vs at the end within 5 %) and its throughput (summary
 # particle_steps_per_second) within 10 % of a run of its first 10^4 steps.
 # Usage: bench/soak.sh [path/to/loam]   (default build/loam; run with nothing else busy)

@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
       app.add_subcommand("compare", "run a sweep of overrides; write compare.csv and pareto.png");
   compare
       ->add_option("sweep", cmp_opt.sweep_file,
-                   "sweep file (YAML: base, axes, set, metric, series)")
+                   "sweep file (YAML: base, axes, set, metrics, metric, series, threads)")
       ->required();
   compare->add_option("--out", cmp_opt.out_dir, "output directory (default results/<sweep name>)");
   compare->add_option("--threads", cmp_opt.threads, "threads per variant")

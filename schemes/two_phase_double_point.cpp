@@ -109,7 +109,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
  public:
   static constexpr const char* name = "two_phase_double_point";
   static constexpr const char* summary =
-      "soil and water as separate solid and liquid points on one grid (double-point, seed 003): "
+      "soil and water as separate solid and liquid points on one grid (double-point, as Liang, "
+      "Zhao & Martinelli's water jet): "
       "pure water, dry and saturated soil in one model; implicit nodal drag; fluidisation at "
       "max_porosity. Particle sets (bodies[].set): solid (the grains: an effective-stress "
       "material, mass (1 - n) rho_s V; fields porosity, contact) and liquid (water: a fluid "
@@ -130,7 +131,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
              "none: every liquid point keeps its own")
         .def("cell");
     s.real("max_porosity", "-",
-           "fluidisation threshold n_max (seed 003: 0.5): a solid point whose porosity reaches "
+           "fluidisation threshold n_max (Liang, Zhao & Martinelli: 0.5): a solid point whose "
+           "porosity reaches "
            "it carries no effective stress and takes the grid's porosity (at least n_max) "
            "until the grains are compressed below it again; default: no fluidisation")
         .above(0)

@@ -80,7 +80,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   static constexpr const char* name = "two_phase_single_point";
   static constexpr const char* summary =
       "saturated soil, one point per volume carrying solid and water (v-w formulation, "
-      "seed 001), implicit nodal drag";
+      "docs/verification.md C), implicit nodal drag";
   static Schema schema() {
     Schema s;
     s.plugin("drag", "drag", "drag law between water and skeleton (darcy, ergun)").required();

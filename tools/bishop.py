@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Limit-equilibrium factor of safety of a simple slope by Bishop's simplified method over
-circular slip surfaces (issue 15: the independent check of loam's strength-reduction factor).
+circular slip surfaces (the independent check of loam's strength-reduction factor).
 
 The slope: a crest at height H for x <= 0, a face at angle beta down to the toe at
 (H / tan beta, 0), a level ground at y = 0 beyond, and an optional firm base at depth D below

@@ -43,7 +43,7 @@ class BlastWave : public Reference<D> {
   static constexpr const char* name = "blast_wave";
   static constexpr const char* summary =
       "blast from a borehole: arrival times at probes against the layers' P-wave speeds (Fermat "
-      "rays), peak displacements, p-q stress paths, failure (seed 002 blast)";
+      "rays), peak displacements, p-q stress paths, failure (docs/blast.md)";
   static Schema schema() {
     Schema s;
     s.text("body", "the body around the cavity (the wave's first layer)").required();

@@ -25,7 +25,8 @@ class ScourDepth : public Reference<D> {
  public:
   static constexpr const char* name = "scour_depth";
   static constexpr const char* summary =
-      "depth of the scour pit of a bed along a vertical axis over time (seed 003 water jet)";
+      "depth of the scour pit of a bed along a vertical axis over time (the water jet of Liang, "
+      "Zhao & Martinelli, docs/verification.md E)";
   static Schema schema() {
     Schema s;
     s.text("body", "the bed (default: the first body)");

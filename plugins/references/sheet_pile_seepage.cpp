@@ -54,8 +54,8 @@ class SheetPileSeepage : public Reference<D> {
  public:
   static constexpr const char* name = "sheet_pile_seepage";
   static constexpr const char* summary =
-      "seepage under a sheet pile: exit gradient and critical head against Harr (seed 000 "
-      "piping)";
+      "seepage under a sheet pile: exit gradient and critical head against Harr (1962), the "
+      "piping scene of docs/verification.md I";
   static Schema schema() {
     Schema s;
     s.text("body", "the soil (default: the first body)");
