@@ -15,7 +15,7 @@ Location place(const YAML::Node& node, const std::string& file) {
   return Location{file, node.Mark().line + 1, node.Mark().column + 1};
 }
 
-/// "loads.0.traction" -> {"loads", "0", "traction"}.
+/// "loads.0.value" -> {"loads", "0", "value"}.
 std::vector<std::string> split_path(const std::string& path) {
   std::vector<std::string> parts;
   size_t start = 0;

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "cli.hpp"
-#include "framework/element_test.hpp"
+#include "app/element_test.hpp"
 #include "material_point.hpp"
 
 namespace {
@@ -253,7 +253,7 @@ TEST_CASE("drucker_prager: bad parameters give the located error",
 TEST_CASE("drucker_prager through loam element-test: the drained triaxial of its example config",
           "[material][element_test][drucker_prager]") {
   // configs/element_tests/drucker_prager_triaxial.yaml's material and path through the driver
-  // (framework/element_test.hpp): c = 0, phi = 30, psi = 10, p'0 = 100 kPa, 200 increments to
+  // (app/element_test.hpp): c = 0, phi = 30, psi = 10, p'0 = 100 kPa, 200 increments to
   // 5 %. Peak q = 200 kPa (Mohr-Coulomb's, compression cone) and the dilation at failure
   // d eps_v / d eps_a = -2 sin psi / (1 - sin psi) = -0.4202766 over the last increment, both to
   // 1e-6 (the driver holds the lateral stress to 1e-10 p'0).

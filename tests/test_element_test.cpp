@@ -1,4 +1,4 @@
-// The element-test driver (framework/element_test.hpp) on linear elasticity, where every path has
+// The element-test driver (app/element_test.hpp) on linear elasticity, where every path has
 // a closed form (docs/verification.md B: the driver itself must be exact before it judges soils),
 // and `loam element-test` through the command line: CSV, exit codes, located errors, no overwrite.
 #include <catch2/catch.hpp>
@@ -8,7 +8,7 @@
 #include <fstream>
 
 #include "cli.hpp"
-#include "framework/element_test.hpp"
+#include "app/element_test.hpp"
 
 namespace {
 

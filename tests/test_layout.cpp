@@ -1,6 +1,7 @@
 // The core names no concrete plugin: framework/ (framework/mpi/ included) includes nothing from
-// the plugin directories and no framework source spells a registered plugin's name as a string
-// literal (docs/architecture.md).
+// the plugin directories, nor from the executable's commands (app/) or the benchmarks (bench/),
+// and no framework source spells a registered plugin's name as a string literal
+// (docs/architecture.md).
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
@@ -12,7 +13,8 @@
 
 namespace fs = std::filesystem;
 
-TEST_CASE("framework/ includes nothing from plugin directories and names no plugin", "[layout]") {
+TEST_CASE("framework/ includes nothing from plugins, app/ or bench/ and names no plugin",
+          "[layout]") {
   std::vector<std::string> names;
   for (const auto& k : loam::Registry::instance().kinds())
     for (const auto& n : loam::Registry::instance().names(k.name)) names.push_back(n);
@@ -27,7 +29,8 @@ TEST_CASE("framework/ includes nothing from plugin directories and names no plug
     ss << in.rdbuf();
     const std::string text = ss.str();
     INFO(e.path().filename().string());
-    for (const char* dir : {"materials/", "shapefunctions/", "schemes/", "plugins/"})
+    for (const char* dir : {"materials/", "shapefunctions/", "schemes/", "plugins/", "app/",
+                            "bench/", "../app/", "../bench/"})
       CHECK(text.find(std::string("#include \"") + dir) == std::string::npos);
     for (const auto& n : names) {
       INFO("plugin name " << n);

@@ -1,7 +1,7 @@
 // Unit tests of the two large-deformation formulations of linear_elastic
 // (docs/verification.md C "Seed 001, large strain"): jaumann (hypoelastic Cauchy stress, Jaumann
 // rate) and hencky (hyperelastic Kirchhoff stress of the logarithmic strain). Paths run through the
-// element-test driver (framework/element_test.hpp) and through one material point in 1D, 2D and
+// element-test driver (app/element_test.hpp) and through one material point in 1D, 2D and
 // 3D whose volume and deformation gradient are updated as the schemes do (V *= det(I + L dt),
 // F <- (I + L dt) F) before the material's stress update. Tension positive throughout.
 #include <Eigen/Dense>
@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "cli.hpp"
-#include "framework/element_test.hpp"
+#include "app/element_test.hpp"
 #include "framework/tensor.hpp"
 #include "sim_helpers.hpp"
 

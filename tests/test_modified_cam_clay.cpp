@@ -1,5 +1,5 @@
 // Unit tests of the modified_cam_clay material (docs/verification.md section B): laboratory paths
-// through the element-test driver (framework/element_test.hpp), single material points in 1D,
+// through the element-test driver (app/element_test.hpp), single material points in 1D,
 // 2D and 3D driven directly through MaterialBatch, and the parameter checks through the command
 // line. In the formulas p', q, strains and pc are compression positive (soil mechanics); the
 // material itself stores tension-positive Cauchy stress.
@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "cli.hpp"
-#include "framework/element_test.hpp"
+#include "app/element_test.hpp"
 #include "framework/tensor.hpp"
 #include "material_point.hpp"
 

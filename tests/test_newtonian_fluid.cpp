@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "cli.hpp"
-#include "framework/element_test.hpp"
+#include "app/element_test.hpp"
 #include "material_point.hpp"
 #include "sim_helpers.hpp"
 

@@ -20,7 +20,7 @@
 #include <string>
 
 #include "cli.hpp"
-#include "framework/element_test.hpp"
+#include "app/element_test.hpp"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "cli.hpp"
-#include "framework/element_test.hpp"
+#include "app/element_test.hpp"
 #include "framework/tensor.hpp"
 #include "material_point.hpp"
 

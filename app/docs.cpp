@@ -2,8 +2,8 @@
 
 #include <sstream>
 
-#include "config.hpp"
-#include "registry.hpp"
+#include "framework/config.hpp"
+#include "framework/registry.hpp"
 
 namespace loam {
 

@@ -16,9 +16,9 @@
 #include <set>
 #include <sstream>
 
-#include "diagnostics.hpp"
-#include "interrupt.hpp"
-#include "params.hpp"
+#include "framework/diagnostics.hpp"
+#include "framework/interrupt.hpp"
+#include "framework/params.hpp"
 #include "process.hpp"
 
 namespace fs = std::filesystem;

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "diagnostics.hpp"
-#include "params.hpp"
+#include "framework/diagnostics.hpp"
+#include "framework/params.hpp"
 
 namespace loam {
 

@@ -4,16 +4,16 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
-#include "bench/bench.hpp"
+#include "bench.hpp"
 #include "compare.hpp"
-#include "config.hpp"
 #include "docs.hpp"
 #include "element_test.hpp"
-#include "launch.hpp"
+#include "framework/config.hpp"
+#include "framework/launch.hpp"
+#include "framework/runner.hpp"
 #include "plot.hpp"
-#include "runner.hpp"
 #ifdef LOAM_WITH_MPI
-#include "mpi/mpi_ranks.hpp"
+#include "framework/mpi/mpi_ranks.hpp"
 #endif
 
 int main(int argc, char** argv) {

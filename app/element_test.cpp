@@ -10,10 +10,10 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "config.hpp"
+#include "framework/config.hpp"
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
 #include "process.hpp"
-#include "registry.hpp"
-#include "simulation.hpp"
 
 namespace loam {
 
