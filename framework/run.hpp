@@ -2,6 +2,7 @@
 // Internal to the runner, included only by runner.cpp and run_output.cpp: one run of a validated
 // configuration (Run<D>), its probes and the CSV files it writes. runner.cpp defines the loop and
 // summary.json, run_output.cpp the output directory, the output checks, frames, probes and history.
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -91,6 +92,10 @@ struct Probe {
   CsvFile csv;
 };
 
+/// The step in a checkpoint's file name checkpoint_<step, 8 digits><tag>.h5, or -1 when the
+/// name is not a checkpoint's with this tag (run_checkpoint.cpp).
+long checkpoint_step(const std::filesystem::path& file, const std::string& tag = "");
+
 template <int D>
 class Run {
  public:
@@ -122,7 +127,7 @@ class Run {
     double stage_start = 0, static_since = -1, static_window = 0;
   };
   LoopState ls_;
-  // Checkpoints (output.checkpoint; runner.cpp).
+  // Checkpoints (output.checkpoint, --resume; run_checkpoint.cpp).
   long checkpoint_every_ = 0;
   double checkpoint_wall_ = 0;
   int checkpoint_keep_ = 2;
@@ -210,6 +215,63 @@ class Run {
   /// (collective; the ranks time the same phases).
   void profile_by_rank(nlohmann::json& summary) const;
   RunResult loop();
+
+  // The loop's parts (runner.cpp), in the order loop() calls them.
+  /// How the stage loop ended: what stopped it, if anything.
+  struct LoopEnd {
+    std::string failure;           // an unstable step, a collapsed time step, max_steps
+    int interrupted = 0;           // the signal that stopped the run (InterruptGuard)
+    bool budget = false;           // --max-steps reached
+    std::string stopped_by_stage;  // a stage that did not reach static (if_not_static: stop)
+    std::string write_error;       // the first output that could not be written (exit 4)
+    bool resumable = false;        // the interruption left a checkpoint
+  };
+  LoopEnd end_;
+  /// When outputs are due: the running stage's frame interval, the history's, checkpoints.
+  struct OutputSchedule {
+    long every_steps = 0, history_every = 0;
+    double every_time = 0, min_dt_ratio = 0;
+    std::chrono::steady_clock::time_point last_checkpoint;
+  };
+  OutputSchedule schedule_;
+  /// The progress lines: when the run began, the last line and its step.
+  struct Progress {
+    std::chrono::steady_clock::time_point start, last;
+    long steps = 0;
+  };
+  Progress progress_;
+  bool keep_good_image_ = false;  // checkpoints of the last good state are possible
+  /// What the coming step's end writes.
+  struct Due {
+    bool frame = false, last = false, checkpoint = false;
+  };
+  /// Runs `write`; a failed write is recorded in end_.write_error (serially, later writes are
+  /// then skipped).
+  template <class F>
+  void guarded(F&& write);
+  /// Restores a checkpoint (or takes the initial energies), opens the outputs, first frame.
+  void start_loop();
+  void begin_stage(int k);
+  void run_stages();
+  /// One step of a stage; false when the stage (or the run) stops after it.
+  bool take_step(const Stage<D>& stage, double t_end, bool& reached_static);
+  /// The stable time step, cut at the stage's end (0 with end_.failure when it collapsed).
+  double next_dt(double t_end);
+  Due outputs_due(double dt, double t_end);
+  void write_due(const Due& due);
+  void report_progress();
+  /// The stage's record and, when it did not reach static, the warning and its consequence.
+  void end_stage(int k, bool stopped, bool reached_static);
+  /// summary.json's strength_reduction record (null when not asked for).
+  nlohmann::json run_strength_reduction();
+  void write_interrupted_state(const nlohmann::json& srf);
+  nlohmann::json run_summary(double wall, double particles);
+  void summarise_masses(nlohmann::json& summary) const;
+  nlohmann::json verify_summary();
+  void record_failure(RunResult& res);
+  void record_interruption(RunResult& res) const;
+  void close_outputs(RunResult& res);
+  void drop_resume_checkpoints(const RunResult& res);
 };
 
 }  // namespace detail

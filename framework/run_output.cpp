@@ -416,8 +416,8 @@ void Run<D>::write_frame(const std::string& label) {
   ++frames_;
 }
 
-// The class is instantiated once, here (`template class`); runner.cpp instantiates the members it
-// defines (execute, base_summary, loop) where it uses them.
+// The class is instantiated once, here (`template class`); runner.cpp and run_checkpoint.cpp
+// instantiate the members they define where they use them or explicitly.
 template class Run<1>;
 template class Run<2>;
 template class Run<3>;
