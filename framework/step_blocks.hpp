@@ -21,6 +21,31 @@
 
 namespace loam {
 
+/// What a particle-to-grid pass scatters: mass and momentum, the forces, or both (USF scatters
+/// them in two passes around the stress update; USL and MUSL in one).
+enum class Scatter { kMomentum, kForce, kMomentumAndForce };
+constexpr bool scatters_momentum(Scatter s) {
+  return s != Scatter::kForce;
+}
+constexpr bool scatters_force(Scatter s) {
+  return s != Scatter::kMomentum;
+}
+
+/// What a grid-to-particle velocity pass does besides the FLIP/PIC update of the velocities:
+/// re-map the new momenta to the grid (MUSL's first pass), nothing more (USL with APIC), or move
+/// the particles with the updated grid velocity (USF).
+enum class VelocityPass { kRemap, kUpdate, kUpdateAndMove };
+constexpr bool remaps(VelocityPass p) {
+  return p == VelocityPass::kRemap;
+}
+constexpr bool moves(VelocityPass p) {
+  return p == VelocityPass::kUpdateAndMove;
+}
+
+/// The order of an explicit step's grid update and stress update (Sulsky et al. 1995; Bardenhagen
+/// 2002): update stress last, modified update stress last, update stress first.
+enum class UpdateOrder { kUsl, kMusl, kUsf };
+
 /// What every scheme's block loop needs per thread: the stencil of the block, the velocity
 /// gradients of the block in MaterialBatch layout (L[(i*D + j)*kBlock + p]), and the largest
 /// particle speed squared seen in the step. A scheme derives from it for its own buffers.

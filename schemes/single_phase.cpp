@@ -71,7 +71,9 @@ class SinglePhase : public Scheme<D> {
   }
   explicit SinglePhase(const Params& p)
       : params_(p),
-        update_(p.text("update")),
+        update_(p.text("update") == "usf"    ? UpdateOrder::kUsf
+                : p.text("update") == "musl" ? UpdateOrder::kMusl
+                                             : UpdateOrder::kUsl),
         flip_(p.real("flip")),
         transfer_(p.text("transfer")),
         affine_on_(AffineTransfer<D>::is_affine(transfer_)),
@@ -97,7 +99,7 @@ class SinglePhase : public Scheme<D> {
         diag.error(params_.where("transfer"), params_.path("transfer"),
                    "contact between bodies takes transfer: flip (the affine moments of two "
                    "velocity fields are not implemented)");
-      if (update_ == "usl" && !sim.shape->stencil_covers_domain())
+      if (update_ == UpdateOrder::kUsl && !sim.shape->stencil_covers_domain())
         diag.error(params_.where("update"), params_.path("update"),
                    "contact with update: usl needs a shape function whose stencil covers the "
                    "particle's domain (gimp, cpdi, bspline2): with linear tents a node that one "
@@ -110,7 +112,7 @@ class SinglePhase : public Scheme<D> {
     if (!affine_on_) return;
     affine_.setup(sim.grid, *sim.shape, transfer_ == "tpic");
     B_ = sim.request_field(affine_.field_info("affine_moment", "velocity"));
-    if (affine_.needs_usf() && update_ != "usf")
+    if (affine_.needs_usf() && update_ != UpdateOrder::kUsf)
       diag.error(params_.where("transfer"), params_.path("transfer"),
                  "transfer: " + transfer_ +
                      " with linear tents needs update: usf (C_p is the velocity gradient of the "
@@ -141,10 +143,10 @@ class SinglePhase : public Scheme<D> {
       constexpr int NPP = decltype(npp)::value;
       auto with_fields = [&](auto fields) {
         constexpr Fields FIELDS = decltype(fields)::value;
-        if (update_ == "usf")
+        if (update_ == UpdateOrder::kUsf)
           step_usf<NPP, FIELDS>(sim, dt);
         else
-          step_usl_musl<NPP, FIELDS>(sim, dt, update_ == "musl");
+          step_usl_musl<NPP, FIELDS>(sim, dt);
       };
       if (contact_.on())
         with_fields(std::integral_constant<Fields, Fields::kPerBody>{});
@@ -159,7 +161,7 @@ class SinglePhase : public Scheme<D> {
   static constexpr int kMass = 0, kMomentum = 1, kForce = 1 + D, S = 1 + 2 * D;
   static constexpr int NS = Particles<D>::NS;
   Params params_;
-  std::string update_;
+  UpdateOrder update_;
   double flip_;
   std::string transfer_;      // flip, apic or tpic
   bool affine_on_;            // an affine transfer (apic or tpic)
@@ -181,18 +183,18 @@ class SinglePhase : public Scheme<D> {
 
   // ------------------------------------------------------------------ the steps
   template <int NPP, Fields FIELDS>
-  void step_usl_musl(Simulation<D>& sim, double dt, bool musl) {
+  void step_usl_musl(Simulation<D>& sim, double dt) {
     sim.timed("grid", [&] { zero_records<FIELDS>(sim); });
-    sim.timed("p2g", [&] { scatter_all<NPP, true, true, FIELDS>(sim); });
+    sim.timed("p2g", [&] { scatter_all<NPP, Scatter::kMomentumAndForce, FIELDS>(sim); });
     complete_records<FIELDS>(sim, kMass, S, true);
     sim.timed("grid", [&] { update_nodes<FIELDS>(sim, dt); });
     reset_max_speed(scratch_);
-    if (musl) {
+    if (update_ == UpdateOrder::kMusl) {
       // MUSL: re-map the updated particle momentum; the velocity gradient uses that field, and
       // particles move with the grid velocity of the update (Sulsky 1995).
       sim.timed("grid", [&] { zero_remap<FIELDS>(sim); });
       sim.timed("g2p_velocity_remap",
-                [&] { update_velocities<NPP, true, false, FIELDS>(sim, dt); });
+                [&] { update_velocities<NPP, VelocityPass::kRemap, FIELDS>(sim, dt); });
       sim.timed("grid", [&] { remapped_velocities<FIELDS>(sim); });
       sim.timed("g2p_gradient_stress",
                 [&] { update_stresses<NPP, Gradient::kRemapped, FIELDS>(sim, dt); });
@@ -200,7 +202,8 @@ class SinglePhase : public Scheme<D> {
       // USL: gradient, move and velocity update from the updated grid record in one pass (APIC:
       // its G2P first, at the positions before the move; the pass then only moves).
       if (affine_on_)
-        sim.timed("g2p_velocity", [&] { update_velocities<NPP, false, false, FIELDS>(sim, dt); });
+        sim.timed("g2p_velocity",
+                  [&] { update_velocities<NPP, VelocityPass::kUpdate, FIELDS>(sim, dt); });
       sim.timed("g2p_gradient_stress",
                 [&] { update_stresses<NPP, Gradient::kUpdated, FIELDS>(sim, dt); });
     }
@@ -211,17 +214,17 @@ class SinglePhase : public Scheme<D> {
   void step_usf(Simulation<D>& sim, double dt) {
     // USF: stress from the velocity field at t^n, then forces, then the grid update.
     zero_records<FIELDS>(sim);
-    scatter_all<NPP, true, false, FIELDS>(sim);
+    scatter_all<NPP, Scatter::kMomentum, FIELDS>(sim);
     complete_records<FIELDS>(sim, kMass, 1 + D, true);
     momentum_to_velocity(sim, node_.data(), S, kMomentum);
     if constexpr (FIELDS == Fields::kPerBody)
       contact_.velocities_from_momenta(sim, ContactFields<D>::Momentum::kRecord);
     update_stresses<NPP, Gradient::kCurrent, FIELDS>(sim, dt);
-    scatter_all<NPP, false, true, FIELDS>(sim);
+    scatter_all<NPP, Scatter::kForce, FIELDS>(sim);
     complete_records<FIELDS>(sim, kForce, D, false);
     update_nodes<FIELDS>(sim, dt);
     reset_max_speed(scratch_);
-    update_velocities<NPP, false, true, FIELDS>(sim, dt);
+    update_velocities<NPP, VelocityPass::kUpdateAndMove, FIELDS>(sim, dt);
     sim.max_speed = max_speed(scratch_);
   }
 
@@ -296,39 +299,39 @@ class SinglePhase : public Scheme<D> {
   }
 
   // ------------------------------------------------------------------ the phases
-  /// P2G over every set: mass and momentum (MOMENTUM), internal, gravity and external forces
-  /// (FORCE), all sets summed onto the one node record (with contact: onto their bodies'
-  /// fields, with their volume and its gradient).
-  template <int NPP, bool MOMENTUM, bool FORCE, Fields FIELDS>
+  /// P2G over every set: mass and momentum, internal, gravity and external forces (WHAT), all
+  /// sets summed onto the one node record (with contact: onto their bodies' fields, with their
+  /// volume and its gradient).
+  template <int NPP, Scatter WHAT, Fields FIELDS>
   void scatter_all(Simulation<D>& sim) {
-    if (fbar_.on()) sim.timed("fbar", [&] { fbar_before_scatter<MOMENTUM, FORCE, FIELDS>(sim); });
+    if (fbar_.on()) sim.timed("fbar", [&] { fbar_before_scatter<WHAT, FIELDS>(sim); });
     // APIC's P2G is its own instantiation per form: the FLIP loop stays as it is without it.
     // Contact takes FLIP only (setup).
     sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
       affine_.template evaluate_with_form<NPP>(
-          sim, s.particles, b, c, scratch_[size_t(t)]->stencil, MOMENTUM && B_ >= 0,
+          sim, s.particles, b, c, scratch_[size_t(t)]->stencil, scatters_momentum(WHAT) && B_ >= 0,
           [&](auto form) {
             constexpr AffineForm FORM = decltype(form)::value;
             if constexpr (FIELDS == Fields::kShared || FORM == AffineForm::kOff)
-              scatter<NPP, MOMENTUM, FORCE, FORM, FIELDS>(sim, s, b, c, t);
+              scatter<NPP, WHAT, FORM, FIELDS>(sim, s, b, c, t);
           });
     });
   }
-  /// G2P velocity update (FLIP/PIC, or APIC's: update_velocity_apic); with REMAP the new
-  /// momentum is scattered into vel_ (MUSL), with MOVE the particles move with the updated grid
+  /// G2P velocity update (FLIP/PIC, or APIC's: update_velocity_apic); PASS kRemap scatters the
+  /// new momentum into vel_ (MUSL), kUpdateAndMove moves the particles with the updated grid
   /// velocity.
-  template <int NPP, bool REMAP, bool MOVE, Fields FIELDS>
+  template <int NPP, VelocityPass PASS, Fields FIELDS>
   void update_velocities(Simulation<D>& sim, double dt) {
     auto f = [&](ParticleSet<D>& s, size_t b, int c, int t) {
       if (FIELDS == Fields::kPerBody || !affine_on_)
-        return update_velocity<NPP, REMAP, MOVE, FIELDS>(sim, s, dt, b, c, t);
+        return update_velocity<NPP, PASS, FIELDS>(sim, s, dt, b, c, t);
       StencilBlock<D>& st = scratch_[size_t(t)]->stencil;
       affine_.evaluate(sim, s.particles, b, c, st);
       affine_.template with_form<NPP>(st, [&](auto form) {
-        update_velocity_apic<NPP, REMAP, MOVE, decltype(form)::value>(sim, s, dt, b, c, t);
+        update_velocity_apic<NPP, PASS, decltype(form)::value>(sim, s, dt, b, c, t);
       });
     };
-    if constexpr (REMAP)
+    if constexpr (remaps(PASS))
       sim.scatter_blocks(f);
     else
       sim.gather_blocks(f);
@@ -363,11 +366,11 @@ class SinglePhase : public Scheme<D> {
   }
   /// F-bar at a scatter: where the particles are (the step's first scatter), and the mean
   /// stress projected for the internal force (framework/fbar.hpp).
-  template <bool MOMENTUM, bool FORCE, Fields FIELDS>
+  template <Scatter WHAT, Fields FIELDS>
   void fbar_before_scatter(Simulation<D>& sim) {
     with_fbar_groups<FIELDS>(sim, [&](int groups, auto group) {
-      if (MOMENTUM) fbar_.locate(sim, groups, group);
-      if (FORCE) fbar_.project_mean_stress(sim, group);
+      if (scatters_momentum(WHAT)) fbar_.locate(sim, groups, group);
+      if (scatters_force(WHAT)) fbar_.project_mean_stress(sim, group);
     });
   }
   /// F-bar (framework/fbar.hpp): the kept velocity gradients' volume ratios projected per
@@ -393,12 +396,13 @@ class SinglePhase : public Scheme<D> {
   }
 
   // ------------------------------------------------------------------ kernels
-  /// Particle-to-grid for one evaluated block: mass and momentum (MOMENTUM; with an affine
-  /// FORM: APIC's), forces (FORCE).
-  template <int NPP, bool MOMENTUM, bool FORCE, AffineForm FORM, Fields FIELDS>
+  /// Particle-to-grid for one evaluated block: mass and momentum (with an affine FORM: APIC's),
+  /// forces, as WHAT says.
+  template <int NPP, Scatter WHAT, AffineForm FORM, Fields FIELDS>
   [[gnu::noinline]] void scatter(Simulation<D>& sim, ParticleSet<D>& set, size_t b, int count,
                                  int thread) {
     constexpr bool AFFINE = FORM != AffineForm::kOff;
+    constexpr bool MOMENTUM = scatters_momentum(WHAT), FORCE = scatters_force(WHAT);
     Particles<D>& P = set.particles;
     const StencilBlock<D>& st = scratch_[size_t(thread)]->stencil;
     const int npp = NPP ? NPP : st.npp;
@@ -534,11 +538,12 @@ class SinglePhase : public Scheme<D> {
     sim.constrain(vel_vector());
   }
 
-  /// Grid-to-particle velocity update of one block (FLIP/PIC blend); REMAP and MOVE as in
+  /// Grid-to-particle velocity update of one block (FLIP/PIC blend); PASS as in
   /// update_velocities (a move never crosses a held face: Simulation::held_faces).
-  template <int NPP, bool REMAP, bool MOVE, Fields FIELDS>
+  template <int NPP, VelocityPass PASS, Fields FIELDS>
   void update_velocity(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
                        int thread) {
+    constexpr bool REMAP = remaps(PASS), MOVE = moves(PASS);
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     StencilBlock<D>& st = sc.stencil;
@@ -595,11 +600,12 @@ class SinglePhase : public Scheme<D> {
   }
 
   /// APIC grid-to-particle update of one evaluated block (the header's equations) from the
-  /// updated grid velocities; with REMAP the MUSL re-map of the new particle momenta, affine
-  /// part included, into vel_; with MOVE the move (after B_p is taken at the old position).
-  template <int NPP, bool REMAP, bool MOVE, AffineForm FORM>
+  /// updated grid velocities; PASS kRemap: the MUSL re-map of the new particle momenta, affine
+  /// part included, into vel_; kUpdateAndMove: the move (after B_p is taken at the old position).
+  template <int NPP, VelocityPass PASS, AffineForm FORM>
   void update_velocity_apic(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count,
                             int thread) {
+    constexpr bool REMAP = remaps(PASS), MOVE = moves(PASS);
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
     const StencilBlock<D>& st = sc.stencil;

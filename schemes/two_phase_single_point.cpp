@@ -112,7 +112,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         n0_(p.real("porosity")),
         Kw_(p.real("water_bulk_modulus")),
         flip_(p.real("flip")),
-        musl_(p.text("update") == "musl"),
+        update_(p.text("update") == "musl" ? UpdateOrder::kMusl : UpdateOrder::kUsl),
         transfer_(p.text("transfer")),
         affine_on_(AffineTransfer<D>::is_affine(transfer_)),
         transfer_where_(p.where("transfer")),
@@ -143,7 +143,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     node_.assign(sim.grid.num_nodes * S, 0.0);
     solved_.assign(sim.grid.num_nodes * 2 * D, 0.0);
     dp_.assign(P.size(), 0.0);
-    if (musl_) remap_.assign(sim.grid.num_nodes * 2 * D, 0.0);
+    if (update_ == UpdateOrder::kMusl) remap_.assign(sim.grid.num_nodes * 2 * D, 0.0);
     scratch_ = make_block_scratch<Scratch>(sim.threads, sim.shape->max_nodes_per_particle(),
                                            [](Scratch& s) { s.Q.assign(size_t(kBlock), 0.0); });
     if (affine_on_) setup_apic(sim, diag);
@@ -215,7 +215,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     F_ = sim.deformation_gradient;  // may be requested after our set-up
     // Per-particle scratch follows the particle count (sources and sinks change it).
     dp_.resize(sim.sets[0].size());
-    if (musl_) move_.resize(sim.sets[0].size() * D);
+    if (update_ == UpdateOrder::kMusl) move_.resize(sim.sets[0].size() * D);
     with_stencil_size<D>(sim.shape->nodes_per_particle(),
                          [&](auto npp) { step_phases<decltype(npp)::value>(sim, dt); });
   }
@@ -233,7 +233,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     sim.complete_nodes({{node_.data(), S, S}});
     sim.timed("grid", [&] { integrate(sim, dt); });
     reset_max_speed(scratch_);
-    if (musl_) {
+    if (update_ == UpdateOrder::kMusl) {
       sim.timed("grid", [&] { zero_nodes(remap_, sim.threads); });
       sim.timed("g2p_velocity_remap", [&] {
         sim.scatter_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
@@ -248,12 +248,14 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     sim.timed("g2p_gradient_stress", [&] {
       sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
         // USL takes B_p here (the stencil with the affine geometry), MUSL took it in the re-map.
-        with_form<NPP>(sim, s, b, c, t, affine_on_ && !musl_, [&](auto form) {
-          constexpr AffineForm F = decltype(form)::value;
-          if constexpr (F == AffineForm::kOff)
-            if (musl_) return update<NPP, true, F>(sim, s, dt, b, c, t);
-          update<NPP, false, F>(sim, s, dt, b, c, t);
-        });
+        with_form<NPP>(sim, s, b, c, t, affine_on_ && update_ != UpdateOrder::kMusl,
+                       [&](auto form) {
+                         constexpr AffineForm F = decltype(form)::value;
+                         if constexpr (F == AffineForm::kOff)
+                           if (update_ == UpdateOrder::kMusl)
+                             return update<NPP, UpdateOrder::kMusl, F>(sim, s, dt, b, c, t);
+                         update<NPP, UpdateOrder::kUsl, F>(sim, s, dt, b, c, t);
+                       });
       });
     });
     sim.timed("pore_pressure", [&] { apply_pressure_increment(sim); });
@@ -283,7 +285,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   static constexpr int NS = Particles<D>::NS;
   std::unique_ptr<Drag<D>> drag_;
   double n0_, Kw_, flip_, rho_w_ = 1000;
-  bool musl_;
+  UpdateOrder update_;       // usl or musl
   std::string transfer_;     // flip, apic or tpic
   bool affine_on_;           // an affine transfer (apic or tpic)
   Location transfer_where_;  // for set-up errors about `transfer`
@@ -590,8 +592,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       const size_t i = b + size_t(p);
       double vs[D], vw[D];
       max_v2 =
-          std::max(max_v2, velocity_update<NPP, false, FORM>(sim, P, st, p, i, npp, dt,
-                                                             &move_[i * D], vs, vw, &as, B, loss));
+          std::max(max_v2, velocity_update<NPP, VelocityPass::kRemap, FORM>(
+                               sim, P, st, p, i, npp, dt, &move_[i * D], vs, vw, &as, B, loss));
       const double ms = m[i], mw = n[i] * rho_w_ * V[i];
       // The re-map carries the affine momenta, with D_p at x^n (as the scatter).
       if constexpr (AFFINE) affine_momenta<NPP>(B, vs, vw, i, npp, ms, mw, as, am_s, am_w);
@@ -632,12 +634,12 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   }
 
   /// Particle p (index i) of a block: FLIP/PIC update of v and w from the grid record and its
-  /// move dt v_grid with the solid grid velocity: done now with MOVE (kept inside the held
-  /// faces), else stored in `move` (D values) for the gradient pass; the new velocities also in
-  /// vs, vw; returns |v|^2. With an affine FORM: v and w from the grid velocities and both B_p
+  /// move dt v_grid with the solid grid velocity: done now with kUpdateAndMove (kept inside the
+  /// held faces), else stored in `move` (D values) for the gradient pass; the new velocities also
+  /// in vs, vw; returns |v|^2. With an affine FORM: v and w from the grid velocities and both B_p
   /// (into the columns B), taken at x^n before the move (framework/affine_transfer.hpp), `as`
   /// left holding the stencil geometry there.
-  template <int NPP, bool MOVE, AffineForm FORM>
+  template <int NPP, VelocityPass PASS, AffineForm FORM>
   double velocity_update(const Simulation<D>& sim, Particles<D>& P, const StencilBlock<D>& st,
                          int p, size_t i, int npp, double dt, double* move, double (&vs)[D],
                          double (&vw)[D], AffineStencil* as, const AffineColumns& B, double& loss) {
@@ -692,7 +694,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       }
       vs[d] = v;
       vw[d] = w;
-      if constexpr (MOVE)
+      if constexpr (moves(PASS))
         P.col(P.position, d)[i] = sim.held_faces.moved(d, P.col(P.position, d)[i], dt * vn[d]);
       else
         move[d] = dt * vn[d];
@@ -704,8 +706,9 @@ class TwoPhaseSinglePoint : public Scheme<D> {
   /// The gradient pass of one evaluated block (USL: with the velocity update, affine FORM as
   /// velocity_update; MUSL: FORM kOff, B_p was taken in the re-map): L of both phases, the
   /// move, volume, F, porosity and the storage equation, then the stress update.
-  template <int NPP, bool REMAPPED, AffineForm FORM>
+  template <int NPP, UpdateOrder ORDER, AffineForm FORM>
   void update(Simulation<D>& sim, ParticleSet<D>& set, double dt, size_t b, int count, int thread) {
+    constexpr bool REMAPPED = ORDER == UpdateOrder::kMusl;
     static_assert(!REMAPPED || FORM == AffineForm::kOff, "MUSL takes B_p in the re-map");
     Particles<D>& P = set.particles;
     Scratch& sc = *scratch_[size_t(thread)];
@@ -724,8 +727,8 @@ class TwoPhaseSinglePoint : public Scheme<D> {
       // (the stencil was evaluated at x^n above, so moving here does not change it).
       if constexpr (!REMAPPED) {
         double vs[D], vw[D];
-        max_v2 = std::max(max_v2, velocity_update<NPP, true, FORM>(sim, P, st, p, i, npp, dt,
-                                                                   nullptr, vs, vw, &as, B, loss));
+        max_v2 = std::max(max_v2, velocity_update<NPP, VelocityPass::kUpdateAndMove, FORM>(
+                                      sim, P, st, p, i, npp, dt, nullptr, vs, vw, &as, B, loss));
       }
       double ls[D][D] = {}, lw[D][D] = {};
       for (int k = 0; k < npp; ++k) {
