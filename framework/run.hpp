@@ -168,6 +168,11 @@ class Run {
 
   // Output (run_output.cpp).
   void check_outputs(Diagnostics& diag);
+  /// A node probe's node from `node` or `node_near`, checked; under mpirun its owner samples it.
+  void locate_probe_node(const Params& pr, Probe<D>& probe, Diagnostics& diag) const;
+  /// A particle probe's particle: of its set (bodies waiting for a stage included), the nearest
+  /// to `particle_near` at t = 0 over all ranks; false (with the error) for a bad or empty set.
+  bool locate_probe_particle(const Params& pr, Probe<D>& probe, Diagnostics& diag);
   std::string prepare_directory();
   /// The output directory: --out, or results/<config name>.
   fs::path output_directory() const;

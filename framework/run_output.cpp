@@ -42,6 +42,65 @@ std::vector<double> Run<D>::nearest_node(const Params& pr, Diagnostics& diag) co
 }
 
 template <int D>
+void Run<D>::locate_probe_node(const Params& pr, Probe<D>& probe, Diagnostics& diag) const {
+  std::array<int, D> node{};
+  const auto ijk = pr.has("node") ? pr.vec("node") : nearest_node(pr, diag);
+  for (int d = 0; d < D; ++d) {
+    long k = std::lround(ijk[size_t(d)]);
+    if (k < 0 || k >= sim_->grid.nodes[d] || std::fabs(ijk[size_t(d)] - double(k)) > 1e-9) {
+      diag.error(pr.where("node"), pr.path("node"),
+                 "node index " + format_number(ijk[size_t(d)]) + " along " + "xyz"[d] +
+                     " is not an integer in [0, " + std::to_string(sim_->grid.nodes[d] - 1) + "]");
+    }
+    node[size_t(d)] = int(std::max(0L, k));
+  }
+  // Under mpirun the rank that owns the node samples it (every copy of a node holds the
+  // whole grid's value, the owner's is the one its boundary conditions act on).
+  probe.samples_node = sim_->ranks->owns_node(sim_->grid, node);
+  if (probe.samples_node) probe.node = sim_->grid.node_index(node);
+}
+
+template <int D>
+bool Run<D>::locate_probe_particle(const Params& pr, Probe<D>& probe, Diagnostics& diag) {
+  probe.set = sim_->set_param(pr, "set", diag);
+  if (probe.set < 0) return false;
+  const Particles<D>& ps = sim_->sets[size_t(probe.set)].particles;
+  for (const auto& name : probe.fields)
+    if (!derived_field(name) && !ps.has(ps.find(name)))
+      diag.error(pr.where("fields"), pr.path("fields"),
+                 "particle set '" + sim_->sets[size_t(probe.set)].name +
+                     "' does not store field '" + name + "'");
+  // The nearest particle of the set, those of its bodies that wait for a stage included
+  // (until its body joins the run, the probe's rows hold nan).
+  const auto& target = pr.vec("particle_near");
+  double best = 1e300;
+  auto nearest = [&](const Particles<D>& candidates) {
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      double r2 = 0;
+      for (int d = 0; d < D; ++d) {
+        double dx = candidates.col(candidates.position, d)[i] - target[size_t(d)];
+        r2 += dx * dx;
+      }
+      if (r2 < best) best = r2, probe.particle_id = candidates.id[i];
+    }
+  };
+  nearest(ps);
+  for (size_t b = 0; b < sim_->bodies.size(); ++b)
+    if (sim_->body_set(int(b)) == probe.set) nearest(sim_->waiting_particles(int(b)));
+  // Under mpirun, the nearest over the ranks; of equally near ones the lowest id, as the
+  // serial search (its candidates are in id order) finds.
+  const auto all = sim_->ranks->all_gather({best, double(probe.particle_id)});
+  for (size_t r = 0; r < all.size(); r += 2)
+    if (all[r] < best || (all[r] == best && all[r + 1] < double(probe.particle_id)))
+      best = all[r], probe.particle_id = uint32_t(all[r + 1]);
+  if (best == 1e300) {
+    diag.error(pr.where("set"), pr.path("set"), "the particle set has no particles");
+    return false;
+  }
+  return true;
+}
+
+template <int D>
 void Run<D>::check_outputs(Diagnostics& diag) {
   // strain_magnitude needs F and its value at the last reset: requested before the names are
   // checked, so that deformation_gradient can be written beside it.
@@ -113,60 +172,10 @@ void Run<D>::check_outputs(Diagnostics& diag) {
         probe.fields.push_back(f[i]);
         need_disp = need_disp || f[i] == "displacement";
       }
-    if (probe.on_node) {
-      std::array<int, D> node{};
-      const auto ijk = pr.has("node") ? pr.vec("node") : nearest_node(pr, diag);
-      for (int d = 0; d < D; ++d) {
-        long k = std::lround(ijk[size_t(d)]);
-        if (k < 0 || k >= sim_->grid.nodes[d] || std::fabs(ijk[size_t(d)] - double(k)) > 1e-9) {
-          diag.error(pr.where("node"), pr.path("node"),
-                     "node index " + format_number(ijk[size_t(d)]) + " along " + "xyz"[d] +
-                         " is not an integer in [0, " + std::to_string(sim_->grid.nodes[d] - 1) +
-                         "]");
-        }
-        node[size_t(d)] = int(std::max(0L, k));
-      }
-      // Under mpirun the rank that owns the node samples it (every copy of a node holds the
-      // whole grid's value, the owner's is the one its boundary conditions act on).
-      probe.samples_node = sim_->ranks->owns_node(sim_->grid, node);
-      if (probe.samples_node) probe.node = sim_->grid.node_index(node);
-    } else {
-      probe.set = sim_->set_param(pr, "set", diag);
-      if (probe.set < 0) continue;
-      const Particles<D>& ps = sim_->sets[size_t(probe.set)].particles;
-      for (const auto& name : probe.fields)
-        if (!derived_field(name) && !ps.has(ps.find(name)))
-          diag.error(pr.where("fields"), pr.path("fields"),
-                     "particle set '" + sim_->sets[size_t(probe.set)].name +
-                         "' does not store field '" + name + "'");
-      // The nearest particle of the set, those of its bodies that wait for a stage included
-      // (until its body joins the run, the probe's rows hold nan).
-      const auto& target = pr.vec("particle_near");
-      double best = 1e300;
-      auto nearest = [&](const Particles<D>& candidates) {
-        for (size_t i = 0; i < candidates.size(); ++i) {
-          double r2 = 0;
-          for (int d = 0; d < D; ++d) {
-            double dx = candidates.col(candidates.position, d)[i] - target[size_t(d)];
-            r2 += dx * dx;
-          }
-          if (r2 < best) best = r2, probe.particle_id = candidates.id[i];
-        }
-      };
-      nearest(ps);
-      for (size_t b = 0; b < sim_->bodies.size(); ++b)
-        if (sim_->body_set(int(b)) == probe.set) nearest(sim_->waiting_particles(int(b)));
-      // Under mpirun, the nearest over the ranks; of equally near ones the lowest id, as the
-      // serial search (its candidates are in id order) finds.
-      const auto all = sim_->ranks->all_gather({best, double(probe.particle_id)});
-      for (size_t r = 0; r < all.size(); r += 2)
-        if (all[r] < best || (all[r] == best && all[r + 1] < double(probe.particle_id)))
-          best = all[r], probe.particle_id = uint32_t(all[r + 1]);
-      if (best == 1e300) {
-        diag.error(pr.where("set"), pr.path("set"), "the particle set has no particles");
-        continue;
-      }
-    }
+    if (probe.on_node)
+      locate_probe_node(pr, probe, diag);
+    else if (!locate_probe_particle(pr, probe, diag))
+      continue;
     probes_.push_back(std::move(probe));
   }
   for (size_t i = 0; i < probes_.size(); ++i)
