@@ -55,6 +55,18 @@ double worst_balance(const Columns& h) {
   return worst / largest_term(h);
 }
 
+/// Runs configs/<config> on 1 thread with the energy ledger (extra arguments appended) and
+/// returns its history.csv columns.
+Columns scene_history(const std::string& config, const std::string& extra = "") {
+  const fs::path dir = fs::temp_directory_path() / ("loam_energy_" + config);
+  const auto r = loam_test::run_loam("run " + std::string(LOAM_SOURCE_DIR) + "/configs/" + config +
+                                     " --quiet --overwrite --out " + dir.string() +
+                                     " --threads 1 --set output.energy_balance=true " + extra);
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  return loam_test::read_csv_columns(dir / "history.csv");
+}
+
 const char* kBar = R"(
 grid: {origin: [0], extent: [10.5], cell_size: 0.25}
 gravity: [0]
@@ -209,14 +221,7 @@ TEST_CASE("energy balance: the drag dissipates what consolidation takes from the
   // single-point v-w scheme): the load's work goes into the skeleton's strain energy and the
   // drag's dissipation Q |w - v|^2 dt (the pore water's pressure work ends there). Tolerance 1 %
   // of the largest term.
-  const fs::path dir = fs::temp_directory_path() / "loam_energy_terzaghi";
-  const auto r =
-      loam_test::run_loam("run " + std::string(LOAM_SOURCE_DIR) +
-                          "/configs/seed001_terzaghi.yaml --quiet --overwrite --out " +
-                          dir.string() + " --threads 1 --set output.energy_balance=true");
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  const auto h = loam_test::read_csv_columns(dir / "history.csv");
+  const auto h = scene_history("seed001_terzaghi.yaml");
   const double w = h.at("work_loads").back(), drag = h.at("dissipation_drag").back();
   const double rel = worst_balance(h);
   std::printf(
@@ -235,14 +240,7 @@ TEST_CASE("energy balance: the double-point liquid's pressure work and the drag 
   // both phases), and the drag dissipates Q |w - v|^2 with the velocities the conditions left
   // (none at the fixed base). Tolerance 1 % of the largest term; the hydrostatic column's drag
   // must be round-off (water at rest over a fixed base).
-  const fs::path dir = fs::temp_directory_path() / "loam_energy_terzaghi_dp";
-  const auto r =
-      loam_test::run_loam("run " + std::string(LOAM_SOURCE_DIR) +
-                          "/configs/terzaghi_double_point.yaml --quiet --overwrite --out " +
-                          dir.string() + " --threads 1 --set output.energy_balance=true");
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  const auto h = loam_test::read_csv_columns(dir / "history.csv");
+  const auto h = scene_history("terzaghi_double_point.yaml");
   const double w = h.at("work_loads").back(), drag = h.at("dissipation_drag").back();
   const double rel = worst_balance(h);
   std::printf(
@@ -253,14 +251,7 @@ TEST_CASE("energy balance: the double-point liquid's pressure work and the drag 
   CHECK(std::fabs(h.at("dissipation_material").back()) < 0.01 * w);
   CHECK(rel <= 0.01);
 
-  const fs::path still = fs::temp_directory_path() / "loam_energy_hydrostatic_dp";
-  const auto s = loam_test::run_loam(
-      "run " + std::string(LOAM_SOURCE_DIR) +
-      "/configs/hydrostatic_double_point.yaml --quiet --overwrite --out " + still.string() +
-      " --threads 1 --set output.energy_balance=true --set time.end=0.2");
-  INFO(s.output);
-  REQUIRE(s.exit_code == 0);
-  const auto hs = loam_test::read_csv_columns(still / "history.csv");
+  const auto hs = scene_history("hydrostatic_double_point.yaml", "--set time.end=0.2");
   const double e = hs.at("strain_energy").back();
   std::printf(
       "hydrostatic double point: D_drag %.3g J, largest |balance| %.3g of E_strain %.3f J\n",
