@@ -6,7 +6,11 @@
 // node component or one particle, so the schemes' node loops stay theirs.
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
+#include "affine_transfer.hpp"
+#include "diagnostics.hpp"
 #include "force_inline.hpp"
 #include "simulation.hpp"
 #include "step_blocks.hpp"
@@ -125,6 +129,49 @@ void constrain_two_phase_update(Simulation<D>& sim, double* records, const TwoPh
                           dt);
   });
   if (sim.ledger.enabled) count_drag_dissipation(sim, records, k, dt);
+}
+
+/// What a node without water mass gives the water's re-mapped velocity: nothing (a double-point
+/// liquid point is the water; no point, no water), or the solid's (the single-point mixture
+/// carries its water with the skeleton).
+enum class MasslessWater { kNone, kFollowsSolid };
+
+/// The MUSL re-map's momenta (solid then water, 2 D values per node) to velocities with the
+/// node masses of the step (node_velocity: light nodes too), then constrained like the update.
+template <int D>
+void remapped_two_phase_velocities(Simulation<D>& sim, const double* records,
+                                   const TwoPhaseRecord& k, std::vector<double>& remap,
+                                   MasslessWater massless) {
+  const double tol = sim.mass_tolerance;
+  double* rm = remap.data();
+  for_each_node(sim.grid.num_nodes, sim.threads, [=](size_t i) {
+    const double* g = records + i * size_t(k.stride);
+    const double ms = g[k.solid_mass], mw = g[k.water_mass];
+    double* r = rm + i * 2 * D;
+    const bool has_water =
+        massless == MasslessWater::kNone || mw > tol || light_node_velocity_scale(mw) > 0;
+    for (int d = 0; d < D; ++d) {
+      r[d] = node_velocity(r[d], ms, tol);
+      r[D + d] = has_water ? node_velocity(r[D + d], mw, tol) : r[d];
+    }
+  });
+  sim.constrain(NodalVector{rm, 2 * D, 0});
+  sim.constrain(NodalVector{rm, 2 * D, D}, 1);
+}
+
+/// The affine transfers (transfer: apic or tpic) in a two-phase scheme: both are MUSL or USL,
+/// never USF, so linear tents (which need USF's gradient, framework/affine_transfer.hpp) and the
+/// shapes AffineTransfer does not fit are refused at `transfer`.
+template <int D>
+void refuse_affine_shape(const AffineTransfer<D>& affine, const ShapeFunction<D>& shape,
+                         const std::string& transfer, const Location& where,
+                         const std::string& path, Diagnostics& diag) {
+  if (affine.needs_usf() || !AffineTransfer<D>::fits(shape))
+    diag.error(where, path,
+               "transfer: " + transfer +
+                   " in this scheme needs gimp, bspline2 or cpdi (linear tents take the affine "
+                   "transfers with update: usf only, which this scheme does not offer: "
+                   "framework/affine_transfer.hpp)");
 }
 
 /// Square of the fastest wave speed of the undamped (drag-free) two-phase equations: the largest

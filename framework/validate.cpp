@@ -124,8 +124,33 @@ struct Validator {
     return parse_elements(n, path, loc, out, real_in_range(spec));
   }
 
+  /// A key's value by its type: one scalar, a list, or a nested map or plugin.
   Params::Value value(const ParamSpec& spec, const YAML::Node& n, const std::string& path,
                       const Location& loc) {
+    switch (spec.type) {
+      case ParamType::Real:
+      case ParamType::Integer:
+      case ParamType::Boolean:
+      case ParamType::String:
+      case ParamType::Choice:
+        return scalar_value(spec, n, path, loc);
+      case ParamType::Vector:
+      case ParamType::RealList:
+      case ParamType::VectorList:
+      case ParamType::StringList:
+        return list_value(spec, n, path, loc);
+      case ParamType::Section:
+      case ParamType::SectionList:
+      case ParamType::PluginList:
+      case ParamType::Plugin:
+        return nested_value(spec, n, path, loc);
+    }
+    return {};
+  }
+
+  /// A real, integer, boolean, string or choice.
+  Params::Value scalar_value(const ParamSpec& spec, const YAML::Node& n, const std::string& path,
+                             const Location& loc) {
     switch (spec.type) {
       case ParamType::Real: {
         double v;
@@ -172,6 +197,15 @@ struct Validator {
                        suggest(n.Scalar(), spec.choices, "valid values are"));
         return {};
       }
+      default:
+        return {};
+    }
+  }
+
+  /// A vector, a list of reals, points or names.
+  Params::Value list_value(const ParamSpec& spec, const YAML::Node& n, const std::string& path,
+                           const Location& loc) {
+    switch (spec.type) {
       case ParamType::Vector: {
         std::vector<double> v;
         if (parse_vector(spec, n, path, loc, v)) return v;
@@ -216,6 +250,15 @@ struct Validator {
         if (parse_elements(n, path, loc, out, name)) return out;
         return {};
       }
+      default:
+        return {};
+    }
+  }
+
+  /// A section, a list of sections or plugins, or a plugin.
+  Params::Value nested_value(const ParamSpec& spec, const YAML::Node& n, const std::string& path,
+                             const Location& loc) {
+    switch (spec.type) {
       case ParamType::Section:
         if (!n.IsMap() && !n.IsNull()) {
           diag.error(loc, path, "expected a map, got " + node_text(n));
@@ -256,8 +299,9 @@ struct Validator {
         return std::make_shared<Params>(
             plugin(n, spec.plugin_kind, spec.plugin_components, path, loc));
       }
+      default:
+        return {};
     }
-    return {};
   }
 
   Params section(const YAML::Node& n, const Schema& schema, const std::string& path,

@@ -255,12 +255,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     affine_.setup(sim.grid, *sim.shape, transfer_ == "tpic");
     B_ = sim.request_field(
         affine_.field_info("affine_moment", "point's own phase velocity (solid v, liquid w)"));
-    if (affine_.needs_usf() || !AffineTransfer<D>::fits(*sim.shape))
-      diag.error(transfer_where_, transfer_path_,
-                 "transfer: " + transfer_ +
-                     " in this scheme needs gimp, bspline2 or cpdi (linear tents take the affine "
-                     "transfers with update: usf only, which this scheme does not offer: "
-                     "framework/affine_transfer.hpp)");
+    refuse_affine_shape(affine_, *sim.shape, transfer_, transfer_where_, transfer_path_, diag);
   }
 
   /// Solid points: porosity n0, solid mass (1 - n0) rho_s V, in contact. Liquid points (at
@@ -615,7 +610,9 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       });
     });
     sim.complete_nodes({{remap_.data(), 2 * D, 2 * D}});
-    sim.timed("grid", [&] { remapped_velocities(sim); });
+    sim.timed("grid", [&] {
+      remapped_two_phase_velocities(sim, node_.data(), kRecord, remap_, MasslessWater::kNone);
+    });
     sim.timed("g2p_gradient_stress", [&] {
       sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
         if (&s == &sim.sets[kSolid])
@@ -976,21 +973,6 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     }
     sc.max_v2 = max_v2;
     if (flip < 1) sim.ledger.add_transfer_loss(sim.set_slot(set), b, 0.5 * loss);
-  }
-
-  /// Re-mapped momenta to velocities (the node masses of the step), constrained like the update.
-  void remapped_velocities(Simulation<D>& sim) {
-    const double tol = sim.mass_tolerance;
-    for_each_record(sim, [&](const double* g, size_t i) {
-      const double ms = g[kMs], mw = g[kMw];
-      double* r = remap_.data() + i * 2 * D;
-      for (int d = 0; d < D; ++d) {
-        r[d] = node_velocity(r[d], ms, tol);
-        r[D + d] = node_velocity(r[D + d], mw, tol);
-      }
-    });
-    sim.constrain(NodalVector{remap_.data(), 2 * D, 0});
-    sim.constrain(NodalVector{remap_.data(), 2 * D, D}, 1);
   }
 
   /// Solid points: L_s from the re-mapped solid velocities, volume, F and porosity, the move,

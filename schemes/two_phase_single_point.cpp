@@ -155,12 +155,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     affine_.setup(sim.grid, *sim.shape, transfer_ == "tpic");
     Bs_ = sim.request_field(affine_.field_info("affine_moment", "solid velocity"));
     Bw_ = sim.request_field(affine_.field_info("water_affine_moment", "water velocity"));
-    if (affine_.needs_usf() || !AffineTransfer<D>::fits(*sim.shape))
-      diag.error(transfer_where_, transfer_path_,
-                 "transfer: " + transfer_ +
-                     " in this scheme needs gimp, bspline2 or cpdi (linear tents take the affine "
-                     "transfers with update: usf only, which this scheme does not offer: "
-                     "framework/affine_transfer.hpp)");
+    refuse_affine_shape(affine_, *sim.shape, transfer_, transfer_where_, transfer_path_, diag);
   }
 
   /// Porosity n0, solid mass (1 - n0) rho_s V (the material density is rho_s), water velocity
@@ -243,7 +238,10 @@ class TwoPhaseSinglePoint : public Scheme<D> {
         });
       });
       sim.complete_nodes({{remap_.data(), 2 * D, 2 * D}});
-      sim.timed("grid", [&] { remapped_velocities(sim); });
+      sim.timed("grid", [&] {
+        remapped_two_phase_velocities(sim, node_.data(), kRecord, remap_,
+                                      MasslessWater::kFollowsSolid);
+      });
     }
     sim.timed("g2p_gradient_stress", [&] {
       sim.gather_blocks([&](ParticleSet<D>& s, size_t b, int c, int t) {
@@ -614,23 +612,6 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     }
     sc.max_v2 = max_v2;
     if (flip_ < 1) sim.ledger.add_transfer_loss(sim.set_slot(set), b, 0.5 * loss);
-  }
-
-  /// Remapped momenta to velocities (node masses of the step), constrained like the update.
-  void remapped_velocities(Simulation<D>& sim) {
-    const double tol = sim.mass_tolerance;
-    for_each_record(sim, [&](const double* g, size_t i) {
-      const double ms = g[kMs], mw = g[kMw];
-      double* r = remap_.data() + i * 2 * D;
-      // Light nodes too (node_velocity); water without mass follows the solid.
-      const bool has_water = mw > tol || light_node_velocity_scale(mw) > 0;
-      for (int d = 0; d < D; ++d) {
-        r[d] = node_velocity(r[d], ms, tol);
-        r[D + d] = has_water ? node_velocity(r[D + d], mw, tol) : r[d];
-      }
-    });
-    sim.constrain(NodalVector{remap_.data(), 2 * D, 0});
-    sim.constrain(NodalVector{remap_.data(), 2 * D, D}, 1);
   }
 
   /// Particle p (index i) of a block: FLIP/PIC update of v and w from the grid record and its
