@@ -199,9 +199,11 @@ double reduce_column(const std::vector<double>& xs, const std::string& of) {
 /// The sweep's own metrics of a variant from its output; a column it lacks is noted in its
 /// message.
 void measure_user_metrics(const Sweep& sweep, const fs::path& dir, Variant& v) {
+  std::map<std::string, std::map<std::string, std::vector<double>>> read;  // each file once
   for (const UserMetric& m : sweep.metrics) {
     const std::string file = m.file == "history" ? "history.csv" : "probe_" + m.file + ".csv";
-    const auto cols = read_columns(dir / file);
+    if (!read.count(file)) read[file] = read_columns(dir / file);
+    const auto& cols = read.at(file);
     if (!cols.count(m.column)) {
       if (v.status == "ok")
         v.message += (v.message.empty() ? "" : "; ") + std::string("metric ") + m.name + ": no " +
@@ -228,12 +230,13 @@ void load_axes(const YAML::Node& root, const ValidationContext& ctx, Sweep& swee
   for (auto it = axes.begin(); it != axes.end(); ++it) {
     Axis a;
     a.path = it->first.Scalar();
-    Location loc = location_of(it->second, "axes." + a.path, ctx, Location{sweep.file, 1, 1});
-    if (!it->second.IsSequence() || it->second.size() == 0) {
+    const YAML::Node values = it->second;
+    Location loc = location_of(values, "axes." + a.path, ctx, Location{sweep.file, 1, 1});
+    if (!values.IsSequence() || values.size() == 0) {
       diag.error(loc, "axes." + a.path, "expected a non-empty list of values");
       continue;
     }
-    for (const auto& v : it->second) {
+    for (const auto& v : values) {
       std::ostringstream text;
       text << YAML::Dump(v);  // keeps lists/maps as flow YAML for --set
       std::string t = text.str();

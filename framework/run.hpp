@@ -270,7 +270,8 @@ class Run {
   /// summary.json's strength_reduction record (null when not asked for).
   nlohmann::json run_strength_reduction();
   void write_interrupted_state(const nlohmann::json& srf);
-  nlohmann::json run_summary(double wall, double particles);
+  /// summary.json: `wall` this rank's wall time, `wall_max` the slowest rank's.
+  nlohmann::json run_summary(double wall, double wall_max, double particles);
   void summarise_masses(nlohmann::json& summary) const;
   nlohmann::json verify_summary();
   void record_failure(RunResult& res);

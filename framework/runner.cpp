@@ -589,7 +589,7 @@ void Run<D>::write_interrupted_state(const nlohmann::json& srf) {
 }
 
 template <int D>
-nlohmann::json Run<D>::run_summary(double wall, double particles) {
+nlohmann::json Run<D>::run_summary(double wall, double wall_max, double particles) {
   Simulation<D>& sim = *sim_;
   const bool distributed = sim.ranks->distributed();
   nlohmann::json s = base_summary();
@@ -599,9 +599,8 @@ nlohmann::json Run<D>::run_summary(double wall, double particles) {
   s["end_time"] = sim.time;
   s["wall_seconds"] = wall;
   s["threads"] = sim.threads;
-  if (distributed) wall = sim.ranks->max(wall);
   s["particle_steps_per_second"] =
-      wall > 0 ? particles * double(sim.step + srf_steps_) / wall : 0.0;
+      wall_max > 0 ? particles * double(sim.step + srf_steps_) / wall_max : 0.0;
   if (distributed) s["ranks"] = sim.ranks->size();
   s["dt_min"] = ls_.dt_min < 1e300 ? ls_.dt_min : 0.0;
   s["dt_max"] = ls_.dt_max;
@@ -779,10 +778,12 @@ RunResult Run<D>::loop() {
   run_stages();
   const nlohmann::json srf = run_strength_reduction();
   write_interrupted_state(srf);
-  double wall = std::chrono::duration<double>(Clock::now() - progress_.start).count();
+  const double wall = std::chrono::duration<double>(Clock::now() - progress_.start).count();
+  // The slowest rank's wall time gives the run's particle-steps per second.
+  const double wall_max = sim_->ranks->distributed() ? sim_->ranks->max(wall) : wall;
   const double particles = global_particles();
   RunResult res;
-  res.summary = run_summary(wall, particles);
+  res.summary = run_summary(wall, wall_max, particles);
   if (!srf.is_null()) {
     res.summary["strength_reduction"] = srf;
     for (const char* k : {"factor_of_safety", "factor_of_safety_bracket"})
@@ -792,9 +793,8 @@ RunResult Run<D>::loop() {
   if (end_.interrupted && end_.failure.empty()) record_interruption(res);
   if (opt_.write_output) close_outputs(res);
   drop_resume_checkpoints(res);
-  if (sim_->ranks->distributed()) wall = sim_->ranks->max(wall);
   if (opt_.report && end_.failure.empty() && !end_.interrupted && sim_->ranks->root())
-    report_end(res.summary, opt_.write_output ? dir_.string() : std::string(), particles, wall);
+    report_end(res.summary, opt_.write_output ? dir_.string() : std::string(), particles, wall_max);
   return res;
 }
 

@@ -365,7 +365,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     F_ = sim.deformation_gradient;  // may be requested after our set-up
     for (int s = 0; s < 2; ++s) move_[s].resize(sim.sets[size_t(s)].size() * D);
     lw_.resize(sim.sets[kLiquid].size() * D * D);
-    volume_rate_.resize(sim.sets[kLiquid].size());
+    if (sim.ledger.enabled) volume_rate_.resize(sim.sets[kLiquid].size());
     with_stencil_size<D>(sim.shape->nodes_per_particle(),
                          [&](auto npp) { step_phases<decltype(npp)::value>(sim, dt); });
   }
@@ -403,7 +403,8 @@ class TwoPhaseDoublePoint : public Scheme<D> {
   std::vector<size_t> liquid_cell_;  // per liquid point: its cell at the step's start
   double inv_cell_volume_ = 1;
   std::vector<double> lw_;           // per liquid point: L_w (D * D values) until its stress update
-  std::vector<double> volume_rate_;  // per liquid point: the step's applied rate (V' - V)/(V dt)
+  std::vector<double> volume_rate_;  // per liquid point, with the energy ledger: the step's
+                                     // applied rate (V' - V)/(V dt)
   CellProjection<D> cells_;  // per grid cell: liquid volume and mass, the density's projection
   bool smooth_ = true;
   double n_max_;  // fluidisation threshold (2: never)
@@ -1111,7 +1112,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       // n: the step's, from the scatter; the water's share of a compression of the pores
       const double share = water_share(saturation);
       const double factor = 1 + dt * (share == 1 || rate > 0 ? rate : share * rate) / P.col(n_)[i];
-      volume_rate_[i] = (factor - 1) / dt;
+      if (!volume_rate_.empty()) volume_rate_[i] = (factor - 1) / dt;  // the energy ledger's
       P.col(P.volume)[i] *= factor;
       if (!(factor > 0)) sc.bad_volume = long(i);
     }

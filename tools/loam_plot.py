@@ -114,15 +114,15 @@ def draw_particles(ax, sets, args, summary):
     missing, spans = [], []
     dim, t = int(summary.get("dimension", 2)), next(iter(frames.values()))[0]
     size = max(0.3, 4000.0 / max(sum(len(d["position"]) for _, d in frames.values()), 1))
+    drawn = {n: field_values(d, field) if field else (None, "") for n, (_, d) in frames.items()}
     # the sets without the field first, in grey, under those that have it
-    order = sorted(frames, key=lambda n: field_values(frames[n][1], field)[0] is not None)
-    for name in order:
+    for name in sorted(frames, key=lambda n: drawn[n][0] is not None):
         time, data = frames[name]
         x = data["position"]
         if len(x) == 0:  # a set with no particles yet (a source's) or any more (a sink's)
             continue
         dim = dimension(summary, x)
-        values, text = field_values(data, field) if field else (None, "")
+        values, text = drawn[name]
         t = time
         if values is None and field:
             missing.append(f"set {name}: {text}")
