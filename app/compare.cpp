@@ -67,6 +67,11 @@ Schema metric_schema() {
   s.choice("of", {"max", "min", "max_abs", "final", "mean"}, "what of the column").def("max_abs");
   s.real("reference", "-",
          "the value it should have: adds NAME_error = (value - reference) / |reference|");
+  s.check([](const Params& m, Diagnostics& d) {
+    if (m.has("reference") && m.real("reference") == 0)
+      d.error(m.where("reference"), m.path("reference"),
+              "a reference of 0 has no relative error; give the value it should have");
+  });
   return s;
 }
 
@@ -266,9 +271,6 @@ void load_keys(const Params& p, const CompareOptions& opt, Sweep& sweep, Diagnos
     const Params& m = list[i];
     UserMetric u{m.text("name"), m.text("file"), m.text("column"), m.text("of")};
     if ((u.has_reference = m.has("reference"))) u.reference = m.real("reference");
-    if (u.has_reference && u.reference == 0)
-      diag.error(m.where("reference"), m.path("reference"),
-                 "a reference of 0 has no relative error; give the value it should have");
     sweep.metrics.push_back(u);
   }
 }

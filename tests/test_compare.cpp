@@ -204,3 +204,28 @@ TEST_CASE("loam compare without any error metric says how to name one", "[compar
                            sweep.string() + ", or define one under `metrics:` with a `reference`"));
   CHECK(r.output.find("--metric") == std::string::npos);
 }
+
+TEST_CASE("loam compare: a bad metrics entry is located, every error at once", "[compare]") {
+  TempDir dir("compare_bad_metrics");
+  std::filesystem::create_directories(dir.path);
+  const auto sweep = dir.path / "sweep.yaml";
+  std::ofstream(sweep) << "base: " << LOAM_SOURCE_DIR << "/configs/vibrating_bar.yaml\n"
+                       << "axes:\n  grid.cell_size: [1.0]\n"
+                       << "metrics:\n"
+                       << "  - {name: a, colum: kinetic_energy}\n"
+                       << "  - {name: b, column: kinetic_energy, of: peak}\n"
+                       << "  - {name: c, column: kinetic_energy, reference: 0}\n";
+  auto r = run_loam("compare " + sweep.string() + " --out " + (dir.path / "out").string());
+  INFO(r.output);
+  CHECK(r.exit_code == 2);
+  CHECK_THAT(r.output, Catch::Matchers::Contains(sweep.string() +
+                                                 ":5:15: error: metrics.0.colum: unknown key "
+                                                 "'colum'; did you mean 'column'?"));
+  CHECK_THAT(r.output, Catch::Matchers::Contains(sweep.string() + ":6:43: error: metrics.1.of: "
+                                                                  "unknown value 'peak'"));
+  CHECK_THAT(r.output, Catch::Matchers::Contains(
+                           sweep.string() +
+                           ":7:50: error: metrics.2.reference: a reference of 0 has no relative "
+                           "error; give the value it should have"));
+  CHECK_FALSE(std::filesystem::exists(dir.path / "out"));
+}
