@@ -1,6 +1,7 @@
 // The schema of a run file: every key, its type, unit, range and documentation, from which the
 // validation, `loam schema` and docs/config.md come (the plugins' own keys are their schemas).
 #include <string>
+#include <utility>
 
 #include "config.hpp"
 #include "particles.hpp"
@@ -116,8 +117,9 @@ Schema strength_reduction_schema() {
                 "strength: Material::reduced)")
       .def("[]");
   r.real("max_time", "s",
-         "simulated time of a trial: a trial not static by then has failed (the slope is still "
-         "moving)")
+         "the longest simulated time a trial may take: one neither static nor moved "
+         "failure_displacement by then is undecided (counted as failed; the search's status is "
+         "undecided when such a trial bounds the bracket)")
       .positive();
   r.real("static_speed", "m/s",
          "a trial is static once every particle moves slower than this for static_window "
@@ -130,8 +132,8 @@ Schema strength_reduction_schema() {
       .def("0")
       .min(0);
   r.real("failure_displacement", "m",
-         "a trial fails at once when a particle has moved this far from the static state "
-         "(default: only the time limit decides)")
+         "a trial has failed when a particle has moved this far from the static state (along a "
+         "periodic axis the nearest image)")
       .positive();
   r.check([](const Params& p, Diagnostics& d) {
     if (!p.has("factors")) return;
@@ -324,11 +326,14 @@ void check_time_and_stages(const Params& p, Diagnostics& d) {
       d.error(r.where(), r.path(),
               "strength reduction starts from a static state: the last stage must be `until: "
               "static` (e.g. the gravity stage)");
-    for (const char* k : {"factors", "max_time"})
+    const std::pair<const char*, const char*> needed[] = {
+        {"factors", "[F_low, F_high]"},
+        {"max_time", "the time limit of a trial, s"},
+        {"failure_displacement", "the displacement at which a trial has failed, m"}};
+    for (const auto& [k, what] : needed)
       if (!r.present(k))
         d.error(r.where(), r.path(k),
-                std::string("missing required key '") + k + "' (" +
-                    (k[0] == 'f' ? "[F_low, F_high]" : "the time limit of a trial, s") + ")");
+                std::string("missing required key '") + k + "' (" + what + ")");
   }
 }
 

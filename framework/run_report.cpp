@@ -93,6 +93,9 @@ std::string strength_reduction_text(const json& srf) {
     };
     text += " [" + end(b[0]) + ", " + end(b[1]) + "]";
   }
+  if (srf.contains("undecided_factor"))
+    text += fmt::format(" (the trial F = {:.5g} was still moving at max_time)",
+                        number(srf, "undecided_factor"));
   return text;
 }
 

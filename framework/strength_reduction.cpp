@@ -1,10 +1,14 @@
 // Strength reduction (docs/strength_reduction.md): the factor of safety of the model in the static
 // state the last stage ended in. A trial divides the strength of the chosen bodies by F
 // (Material::reduced: c / F, tan(phi) / F) and runs from that state until it is static again
-// (stable) or max_time passes, or a particle moves failure_displacement from it (failed). The
-// largest stable F is found by bisection on [F_low, F_high] to `tolerance` (Dawson, Roth &
-// Drescher 1999; Griffiths & Lane 1999, for finite elements). Every trial starts from the same
-// in-memory copy of the static state, so trials are independent of their order.
+// (stable) or a particle has moved failure_displacement from it (failed). The motion decides,
+// not the time it takes: near the factor a model can creep for seconds at a steady rate and
+// then stop, or go on, and no trend of the motion tells which beforehand. max_time only bounds
+// a trial's cost; a trial still moving then is undecided, counted as failed, and the search
+// says so when such a trial bounds the bracket. The largest stable F is found by bisection on
+// [F_low, F_high] to `tolerance` (Dawson, Roth & Drescher 1999; Griffiths & Lane 1999, for
+// finite elements). Every trial starts from the same in-memory copy of the static state, so
+// trials are independent of their order.
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -25,6 +29,17 @@ const Material<D>& final_material(const Simulation<D>& sim, int b) {
     for (const auto& c : st->materials)
       if (c.body == b) return *c.material;
   return *sim.materials[size_t(b)];
+}
+
+/// The undecided trial that bounds the search's bracket, if any: the smallest failed factor of a
+/// converged search, or F_low of a search below its bracket. Its verdict would change with
+/// max_time (docs/strength_reduction.md, "What a trial does").
+const nlohmann::json* undecided_bound(const nlohmann::json& trials, const std::string& status,
+                                      double lo, double hi) {
+  const double bound = status == "converged" ? hi : status == "below_bracket" ? lo : NAN;
+  for (const auto& t : trials)
+    if (t["factor"].get<double>() == bound && t["status"] == "undecided") return &t;
+  return nullptr;
 }
 
 }  // namespace
@@ -105,8 +120,8 @@ double Run<D>::default_static_window() const {
 }
 
 /// One trial from the static state (in sim.last_good on entry): its record, status "static",
-/// "not_static" (max_time passed), "moved" (failure_displacement reached), "unstable" or
-/// "interrupted".
+/// "moved" (failure_displacement reached), "undecided" (still moving when max_time passed),
+/// "unstable" or "interrupted".
 template <int D>
 nlohmann::json Run<D>::srf_trial(const typename Simulation<D>::GoodState& start, double F) {
   Simulation<D>& sim = *sim_;
@@ -121,10 +136,9 @@ nlohmann::json Run<D>::srf_trial(const typename Simulation<D>::GoodState& start,
   const long step0 = sim.step;
   const double window =
       r.real("static_window") > 0 ? r.real("static_window") : default_static_window();
-  const double fail_u = r.has("failure_displacement") ? r.real("failure_displacement")
-                                                      : std::numeric_limits<double>::infinity();
+  const double fail_u = r.real("failure_displacement");
   const auto wall0 = std::chrono::steady_clock::now();
-  std::string status = "not_static";
+  std::string status = "undecided";
   double since = -1;
   sim.track_motion = true;
   while (sim.time < t_end * (1 - 1e-12)) {
@@ -140,7 +154,7 @@ nlohmann::json Run<D>::srf_trial(const typename Simulation<D>::GoodState& start,
       break;
     }
     if (sim.checked_step != sim.step) continue;
-    if (std::isfinite(fail_u) && largest_displacement() > fail_u) {
+    if (largest_displacement() > fail_u) {
       status = "moved";
       break;
     }
@@ -239,6 +253,17 @@ nlohmann::json Run<D>::strength_reduction() {
   if (!opt_.quiet && sim.ranks->root() && status == "converged")
     spdlog::info("factor of safety {:.4g} (bracket [{:.5g}, {:.5g}], {} trials)", 0.5 * (lo + hi),
                  lo, hi, trials.size());
+  if (const nlohmann::json* t = undecided_bound(trials, status, lo, hi)) {
+    out["status"] = "undecided";
+    out["undecided_factor"] = (*t)["factor"];
+    if (sim.ranks->root())
+      spdlog::warn(
+          "strength reduction: the trial F = {:.5g} bounds the bracket but was still moving when "
+          "max_time = {:g} s passed (largest displacement {:.3g} m, failure_displacement {:g} "
+          "m); it is counted as failed, so the factor of safety may be higher: raise max_time",
+          (*t)["factor"].get<double>(), r.real("max_time"), (*t)["max_displacement"].get<double>(),
+          r.real("failure_displacement"));
+  }
   return out;
 }
 

@@ -80,6 +80,13 @@ TEST_CASE("run report: strength reduction and a run without output or reference"
   s["strength_reduction"] = {{"status", "above_bracket"},
                              {"factor_of_safety_bracket", {2.0, nullptr}}};
   CHECK_THAT(joined(loam::run_report(s, "out")), Contains("above_bracket [2, -]"));
+  s["strength_reduction"] = {{"status", "undecided"},
+                             {"factor_of_safety", 1.5813},
+                             {"factor_of_safety_bracket", {1.575, 1.5875}},
+                             {"undecided_factor", 1.5875}};
+  CHECK_THAT(joined(loam::run_report(s, "out")),
+             Contains("undecided, factor of safety 1.581 [1.575, 1.5875] (the trial F = 1.5875 "
+                      "was still moving at max_time)"));
 }
 
 TEST_CASE("loam run ends by telling its output, status and the reference's comparison",

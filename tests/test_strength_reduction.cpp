@@ -109,28 +109,46 @@ TEST_CASE("strength reduction with F-bar: the infinite slope still gives tan(phi
 }
 
 TEST_CASE(
-    "a strength-reduction verdict does not depend on the thread count (psi = 0 and psi = phi)",
+    "a strength-reduction verdict depends neither on the thread count nor on max_time (psi = 0 "
+    "and psi = phi)",
     "[srf][full]") {
-  // The infinite slope with psi = 0 creeps in bursts between F = 1.30 and 1.40
-  // (docs/strength_reduction.md): the F = 1.35 trial came to rest at 3.93 s on 1 thread and not
-  // within 4 s on 2, and the factor was 1.356 [1.350, 1.3625] against 1.319 [1.3125, 1.325].
-  // With the slabs cut without regard to the thread count (framework/partition.hpp) the runs
-  // have the same bits: every trial's record, and so the bracket, must be equal. Printed: the
-  // factor and bracket per thread count.
+  // docs/strength_reduction.md, "What a trial does" and "A verdict near the factor": the motion
+  // decides a trial (at rest: stable; failure_displacement reached: failed), max_time only
+  // bounds it. The infinite slope with psi = 0 creeps for up to 22 s before it stops near the
+  // factor; with psi = phi, F = 1.5875 creeps on at about 0.6 mm/s. With the config's max_time
+  // (60 s) every trial decides, so the search must be `converged` with the same bracket at 1
+  // and 2 threads and with max_time doubled; for psi = phi the bracket must hold tan(phi) /
+  // tan(beta) = 1.5863. Printed: the factor and bracket of each run.
   for (const std::string psi : {"0", "30"}) {
-    nlohmann::json srf[2];
-    for (int k = 0; k < 2; ++k) {
-      loam_test::TempDir d("srf_threads");
-      const auto s = loam_test::run_scene("infinite_slope_srf.yaml", d.path / "out",
-                                          "--threads " + std::to_string(k + 1) +
-                                              " --set bodies.0.material.psi=" + psi +
-                                              " --set stages.1.materials.0.material.psi=" + psi);
+    const std::string psi_set =
+        " --set bodies.0.material.psi=" + psi + " --set stages.1.materials.0.material.psi=" + psi;
+    const std::pair<int, double> runs[] = {{1, 60}, {2, 60}, {1, 120}};
+    nlohmann::json srf[3];
+    for (int k = 0; k < 3; ++k) {
+      loam_test::TempDir d("srf_invariance");
+      const auto [threads, max_time] = runs[k];
+      const auto s = loam_test::run_scene(
+          "infinite_slope_srf.yaml", d.path / "out",
+          "--threads " + std::to_string(threads) +
+              " --set strength_reduction.max_time=" + std::to_string(max_time) + psi_set);
       srf[k] = s["strength_reduction"];
-      std::printf("infinite slope, psi = %s deg, %d thread(s): FoS %.4f, bracket [%.4f, %.4f]\n",
-                  psi.c_str(), k + 1, s["factor_of_safety"].get<double>(),
-                  s["factor_of_safety_bracket"][0].get<double>(),
-                  s["factor_of_safety_bracket"][1].get<double>());
+      std::printf(
+          "infinite slope, psi = %s deg, %d thread(s), max_time %g s: %s, FoS %.4f, bracket "
+          "[%.4f, %.4f], %zu trials, %.1f s wall\n",
+          psi.c_str(), threads, max_time, srf[k]["status"].get<std::string>().c_str(),
+          s["factor_of_safety"].get<double>(), s["factor_of_safety_bracket"][0].get<double>(),
+          s["factor_of_safety_bracket"][1].get<double>(), srf[k]["trials"].size(),
+          srf[k]["wall_seconds"].get<double>());
+      INFO(srf[k].dump(1));
+      CHECK(srf[k]["status"] == "converged");
+      if (k > 0) CHECK(s["factor_of_safety_bracket"] == srf[0]["factor_of_safety_bracket"]);
+      if (psi == "30") {
+        const double exact = std::tan(M_PI / 6) / std::tan(20 * M_PI / 180);
+        CHECK(s["factor_of_safety_bracket"][0].get<double>() <= exact);
+        CHECK(s["factor_of_safety_bracket"][1].get<double>() >= exact);
+      }
     }
+    // Threads: the same bits, so every trial's record is equal.
     REQUIRE(srf[0]["trials"].size() == srf[1]["trials"].size());
     for (size_t i = 0; i < srf[0]["trials"].size(); ++i) {
       const auto &a = srf[0]["trials"][i], &b = srf[1]["trials"][i];
@@ -140,6 +158,32 @@ TEST_CASE(
       CHECK(a["max_displacement"].get<double>() == b["max_displacement"].get<double>());
     }
   }
+}
+
+TEST_CASE(
+    "a trial still moving at max_time is undecided, and the search says so when it bounds "
+    "the bracket",
+    "[srf]") {
+  // docs/strength_reduction.md, "What a trial does": with psi = phi, F = 1.5875 creeps at about
+  // 0.6 mm/s and has moved 0.025 m of the 0.05 m failure_displacement after 4 s. With max_time
+  // 4 s it bounds the bracket undecided: status `undecided`, undecided_factor 1.5875, a warning.
+  loam_test::TempDir d("srf_undecided");
+  const auto r = loam_test::run_loam(
+      std::string("run ") + LOAM_SOURCE_DIR + "/configs/infinite_slope_srf.yaml" + " --out " +
+      (d.path / "out").string() + " --threads 2 --set strength_reduction.max_time=4");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  const auto s = summary_of(d.path / "out");
+  const auto& srf = s["strength_reduction"];
+  INFO(srf.dump(1));
+  CHECK(srf["status"] == "undecided");
+  CHECK(srf["undecided_factor"].get<double>() == s["factor_of_safety_bracket"][1].get<double>());
+  CHECK(trial_at(srf, srf["undecided_factor"].get<double>())["status"] == "undecided");
+  CHECK(r.output.find("was still moving when max_time = 4 s passed") != std::string::npos);
+  std::printf(
+      "max_time 4 s: %s, bracket [%.4f, %.4f], undecided F = %.4f\n",
+      srf["status"].get<std::string>().c_str(), s["factor_of_safety_bracket"][0].get<double>(),
+      s["factor_of_safety_bracket"][1].get<double>(), srf["undecided_factor"].get<double>());
 }
 
 TEST_CASE("strength-reduction trials restart from the same static state", "[srf]") {
@@ -237,7 +281,8 @@ TEST_CASE("bad strength-reduction and periodic input: located errors, exit 2, no
       CHECK(r.output.find(f + e) != std::string::npos);
     }
   };
-  // The schema: F_high below F_low, a missing max_time, the last stage not until: static.
+  // The schema: F_high below F_low, missing max_time and failure_displacement, the last stage
+  // not until: static.
   check(model("boundaries: [{type: fixed, face: y-}]\n"
               "stages:\n"
               "  - {name: gravity, until: static, max_time: 1}\n"
@@ -246,12 +291,15 @@ TEST_CASE("bad strength-reduction and periodic input: located errors, exit 2, no
         {":15:21: error: strength_reduction: strength reduction starts from a static state",
          ":15:31: error: strength_reduction.factors: factors = [2, 1.5]: F_high must exceed "
          "F_low",
-         ":15:21: error: strength_reduction.max_time: missing required key 'max_time'"});
+         ":15:21: error: strength_reduction.max_time: missing required key 'max_time'",
+         ":15:21: error: strength_reduction.failure_displacement: missing required key "
+         "'failure_displacement'"});
   // The bodies: an unknown one, an elastic one.
   check(model("boundaries: [{type: fixed, face: y-}]\n" + stages +
-              "strength_reduction: {factors: [1, 2], max_time: 1, bodies: [sand, rock]}\n"),
-        {":14:61: error: strength_reduction.bodies.0: unknown body 'sand'; bodies are: soil, rock",
-         ":14:67: error: strength_reduction.bodies.1: body 'rock' has a material without a "
+              "strength_reduction: {factors: [1, 2], max_time: 1, failure_displacement: 0.1, "
+              "bodies: [sand, rock]}\n"),
+        {":14:88: error: strength_reduction.bodies.0: unknown body 'sand'; bodies are: soil, rock",
+         ":14:94: error: strength_reduction.bodies.1: body 'rock' has a material without a "
          "strength to reduce"});
   // Periodic with a wide stencil, and with a face another condition holds.
   check(model("boundaries: [{type: fixed, face: y-}, {type: periodic, axis: x}, {type: slip, "
@@ -289,6 +337,19 @@ TEST_CASE("the seed-004 slope's factor of safety by strength reduction, beside B
   CHECK(fos > 2.24);
   CHECK(fos < 2.42);
   CHECK(fos > bishop);  // a coarse SRF model is not more critical than limit equilibrium
+  // The verdict is the motion's, not patience's or the threads': on 1 thread with max_time
+  // doubled (40 s) the search ends in the same bracket.
+  {
+    loam_test::TempDir d2("srf_seed004_long");
+    const auto s2 = loam_test::run_scene("seed004_slope_srf.yaml", d2.path / "out",
+                                         "--threads 1 --set strength_reduction.max_time=40");
+    std::printf("seed-004 slope, 1 thread, max_time 40 s: %s, bracket [%.4f, %.4f]\n",
+                s2["strength_reduction"]["status"].get<std::string>().c_str(),
+                s2["factor_of_safety_bracket"][0].get<double>(),
+                s2["factor_of_safety_bracket"][1].get<double>());
+    CHECK(s2["strength_reduction"]["status"] == "converged");
+    CHECK(s2["factor_of_safety_bracket"] == s["factor_of_safety_bracket"]);
+  }
   // The mechanism: the particle that moved most in the lowest failed trial is on the slope's
   // face or crest edge (x in [6, 17] m, above the base layer), a slide, not the base.
   fs::path mechanism;

@@ -61,7 +61,7 @@ def main():
         bx.semilogy(t["factor"], max(t["max_displacement"], 1e-6), "o" if ok else "x",
                     color="tab:green" if ok else "tab:red")
     bx.plot([], [], "o", color="tab:green", label="static")
-    bx.plot([], [], "x", color="tab:red", label="failed (not static / moved)")
+    bx.plot([], [], "x", color="tab:red", label="failed (moved, undecided or unstable)")
     if "factor_of_safety" in srf:
         bx.axvline(srf["factor_of_safety"], color="k", lw=0.8)
         bx.set_title(f"FoS = {srf['factor_of_safety']:.4g}, bracket "
