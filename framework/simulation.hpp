@@ -446,11 +446,19 @@ class Simulation {
 
  private:
   void build_grid(const Params& g, Diagnostics& diag);
+  void read_settings();
+  /// Refuse a run whose stable time step at the start needs more than time.max_steps steps,
+  /// and warn of one that needs implausibly many (a unit slip).
+  void check_step_budget(Diagnostics& diag);
   /// Under mpirun: refuse what does not run on ranks yet, and store this rank's box of nodes.
   void split_over_ranks(Diagnostics& diag);
   /// After the move under mpirun: hand the particles over to the ranks owning their cells.
   void migrate_particles();
   void generate_bodies(Diagnostics& diag);
+  struct GeneratedPoints;  // the lattice points of every body (simulation_build.cpp)
+  bool generate_points(GeneratedPoints& pts, Diagnostics& diag);
+  void fill_sets(const GeneratedPoints& pts);
+  void set_initial_velocity_and_stress(const GeneratedPoints& pts);
   void initialize_fields(Diagnostics& diag);  // bodies[].initial
   void create_plugins(Diagnostics& diag);
   void create_sets(Diagnostics& diag);

@@ -70,13 +70,9 @@ void name_reactions(const std::vector<std::unique_ptr<Boundary<D>>>& list,
 
 }  // namespace
 
+/// gravity, time, numerics and the named selections of the run file.
 template <int D>
-Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag) : config(cfg) {
-  threads = std::max(1, num_threads);
-  // Parallel loops without an explicit num_threads (e.g. in plugins) follow --threads too.
-  omp_set_num_threads(threads);
-  build_grid(config.section("grid"), diag);
-  if (!diag.ok()) return;
+void Simulation<D>::read_settings() {
   const auto& g = config.vec("gravity");
   for (int d = 0; d < D; ++d) gravity[size_t(d)] = g[size_t(d)];
   const Params& t = config.section("time");
@@ -96,6 +92,40 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
       lo[size_t(d)] = s.vec("min")[size_t(d)], hi[size_t(d)] = s.vec("max")[size_t(d)];
     selections_.push_back({s.text("name"), {lo, hi}});
   }
+}
+
+template <int D>
+void Simulation<D>::check_step_budget(Diagnostics& diag) {
+  const Params& t = config.section("time");
+  // Step budget: a stiff set-up (e.g. K_w / n with a porosity near 0) can make the stable time
+  // step so small that the run would never finish; say so before writing anything.
+  const double dt0 = stable_dt();
+  if (end_time / dt0 > double(max_steps))
+    diag.error(t.where("end"), t.path("end"),
+               "the stable time step at the start is " + format_number(dt0) + " s, so " +
+                   format_number(end_time) + " s needs about " +
+                   format_number(std::ceil(end_time / dt0)) +
+                   " steps, more than time.max_steps = " + std::to_string(max_steps) +
+                   " (a stiff material or pore fluid, e.g. K_w / n with a tiny porosity, or a "
+                   "fine grid); raise time.max_steps if this is intended");
+  else if (end_time / dt0 > kPlausibleSteps)
+    diag.warning(t.where("end"), t.path("end"),
+                 "the stable time step at the start is " + format_number(dt0) + " s, so " +
+                     format_number(end_time) + " s needs about " +
+                     format_number(std::ceil(end_time / dt0)) +
+                     " steps: a modulus or bulk modulus in Pa meant in kPa, a density in t/m^3, "
+                     "or cells smaller than meant? (list time.end under accept_warnings: if it "
+                     "is meant)");
+}
+
+template <int D>
+Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag) : config(cfg) {
+  threads = std::max(1, num_threads);
+  // Parallel loops without an explicit num_threads (e.g. in plugins) follow --threads too.
+  omp_set_num_threads(threads);
+  build_grid(config.section("grid"), diag);
+  if (!diag.ok()) return;
+  read_settings();
   // From here on, keep checking after an error wherever the rest does not depend on it, so that
   // one run reports every problem at once.
   create_plugins(diag);
@@ -172,25 +202,7 @@ Simulation<D>::Simulation(const Params& cfg, int num_threads, Diagnostics& diag)
       for (size_t i = 0; i < s.size(); ++i) v2 = std::max(v2, v[i] * v[i]);
     }
   max_speed = ranks->max(std::sqrt(v2));  // over the ranks, as after every step (advance)
-  // Step budget: a stiff set-up (e.g. K_w / n with a porosity near 0) can make the stable time
-  // step so small that the run would never finish; say so before writing anything.
-  const double dt0 = stable_dt();
-  if (end_time / dt0 > double(max_steps))
-    diag.error(t.where("end"), t.path("end"),
-               "the stable time step at the start is " + format_number(dt0) + " s, so " +
-                   format_number(end_time) + " s needs about " +
-                   format_number(std::ceil(end_time / dt0)) +
-                   " steps, more than time.max_steps = " + std::to_string(max_steps) +
-                   " (a stiff material or pore fluid, e.g. K_w / n with a tiny porosity, or a "
-                   "fine grid); raise time.max_steps if this is intended");
-  else if (end_time / dt0 > kPlausibleSteps)
-    diag.warning(t.where("end"), t.path("end"),
-                 "the stable time step at the start is " + format_number(dt0) + " s, so " +
-                     format_number(end_time) + " s needs about " +
-                     format_number(std::ceil(end_time / dt0)) +
-                     " steps: a modulus or bulk modulus in Pa meant in kPa, a density in t/m^3, "
-                     "or cells smaller than meant? (list time.end under accept_warnings: if it "
-                     "is meant)");
+  check_step_budget(diag);
 }
 
 template <int D>
@@ -301,16 +313,30 @@ void Simulation<D>::split_over_ranks(Diagnostics& diag) {
 
 template <int D>
 void Simulation<D>::generate_bodies(Diagnostics& diag) {
+  GeneratedPoints points;
+  if (!generate_points(points, diag)) return;
+  fill_sets(points);
+  set_initial_velocity_and_stress(points);
+}
+
+/// The particles this rank keeps (all of them serially): position, body, volume and id. Each
+/// rank generates only the points of its own cells (walk_body_lattice); the ids (numbered over
+/// all bodies in lattice order) and the bodies' bounding boxes are those of the serial run.
+template <int D>
+struct Simulation<D>::GeneratedPoints {
+  std::vector<Vec> x;
+  std::vector<uint16_t> owner;
+  std::vector<double> volume;
+  std::vector<size_t> id;
+  std::vector<size_t> first_kept;  // per body, its first point here
+};
+
+template <int D>
+bool Simulation<D>::generate_points(GeneratedPoints& pts, Diagnostics& diag) {
   Registry& reg = Registry::instance();
   const auto& bl = config.list("bodies");
   const size_t errors_before = diag.errors().size();
-  // The particles this rank keeps (all of them serially): position, body, volume and id. Each
-  // rank generates only the points of its own cells (walk_body_lattice); the ids (numbered over
-  // all bodies in lattice order) and the bodies' bounding boxes are those of the serial run.
-  std::vector<Vec> xs;
-  std::vector<uint16_t> owner;
-  std::vector<double> vols;
-  std::vector<size_t> ids, first_kept;
+  auto& [xs, owner, vols, ids, first_kept] = pts;
   size_t next_id = 0;
   for (size_t b = 0; b < bl.size(); ++b) {
     first_kept.push_back(xs.size());
@@ -377,15 +403,21 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
     body.spacing.assign(s.begin(), s.end());
     bodies.push_back(std::move(body));
   }
-  if (diag.errors().size() != errors_before) return;
+  if (diag.errors().size() != errors_before) return false;
   if (next_id > size_t(UINT32_MAX)) {
     diag.error(config.where("bodies"), "bodies", "more than 2^32 particles");
-    return;
+    return false;
   }
   // A source's particles are numbered after every generated one (those of the bodies that wait
   // for a stage included), over all ranks.
   next_id_ = uint32_t(next_id);
-  // Each set holds its bodies' particles in body order; ids count over all bodies.
+  return true;
+}
+
+/// Each set holds its bodies' particles in body order; ids count over all bodies.
+template <int D>
+void Simulation<D>::fill_sets(const GeneratedPoints& pts) {
+  const auto& [xs, owner, vols, ids, first_kept] = pts;
   for (auto& body : bodies) body.set = body_set_[size_t(&body - bodies.data())];
   for (size_t si = 0; si < sets.size(); ++si) {
     Particles<D>& P = sets[si].particles;
@@ -408,7 +440,14 @@ void Simulation<D>::generate_bodies(Diagnostics& diag) {
     }
     sets[si].invalidate_index();
   }
-  // Initial velocity and stress fields.
+}
+
+/// The bodies' `velocity:` and `stress:` fields at their particles' positions.
+template <int D>
+void Simulation<D>::set_initial_velocity_and_stress(const GeneratedPoints& pts) {
+  Registry& reg = Registry::instance();
+  const auto& bl = config.list("bodies");
+  const auto& [xs, owner, vols, ids, first_kept] = pts;
   std::vector<double> value(size_t(Particles<D>::NS));
   for (size_t b = 0; b < bl.size(); ++b) {
     const Params& bp = bl[b];

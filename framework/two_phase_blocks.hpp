@@ -69,6 +69,82 @@ struct TwoPhaseRecord {
       water_acceleration, porosity, stride;
 };
 
+/// Which masses make a two-phase node light (below mass_tolerance), and so how it is solved.
+enum class PhaseNodes {
+  /// Single point: the water lives on the solid's points and the force given for the solid is
+  /// the mixture's (F_s = F - F_w). A node is light when its solid is: both phases keep their
+  /// points' mean velocities (water without mass that of the solid), it gets no drag and no
+  /// porosity. Water too light to solve for moves with the solid.
+  kMixture,
+  /// Double point: each phase by its own mass. A node may hold one phase alone, which is
+  /// integrated by itself; a light phase keeps its points' mean velocity.
+  kSeparate,
+};
+
+/// One component of a node's two momentum equations with the drag implicit
+/// (solve_drag_implicit), from the momenta p_s, p_w and the forces F, F_w (F the mixture's for
+/// kMixture, the solid's for kSeparate): the new velocities in vn, wn, their accelerations in
+/// a_s, a_w. A light phase keeps its points' mean velocity p / m without acceleration
+/// (light_node_velocity_scale).
+template <PhaseNodes KIND>
+LOAM_FORCE_INLINE void solve_two_phase_component(double ms, double mw, double Q, double dt,
+                                                 double tol, double ps, double pw, double F,
+                                                 double Fw, double& vn, double& wn, double& a_s,
+                                                 double& a_w) {
+  if constexpr (KIND == PhaseNodes::kMixture) {
+    if (ms <= tol) {
+      const double sw = light_node_velocity_scale(mw);
+      vn = ps * light_node_velocity_scale(ms);
+      wn = sw > 0 ? pw * sw : vn;
+      a_s = a_w = 0.0;
+      return;
+    }
+    const double v = ps / ms, w = mw > tol ? pw / mw : v;
+    const auto s = solve_drag_implicit(ms, mw, Q, dt, ms * v / dt + F - Fw, mw * w / dt + Fw);
+    vn = s.solid, wn = mw <= tol ? s.solid : s.water;
+    a_s = (vn - v) / dt;
+    a_w = (wn - w) / dt;
+  } else {
+    const bool has_s = ms > tol, has_w = mw > tol;
+    const double v = has_s ? ps / ms : 0.0, w = has_w ? pw / mw : 0.0;
+    vn = ps * light_node_velocity_scale(ms), wn = pw * light_node_velocity_scale(mw);
+    if (has_s && has_w) {
+      const auto s = solve_drag_implicit(ms, mw, Q, dt, ms * v / dt + F, mw * w / dt + Fw);
+      vn = s.solid, wn = s.water;
+    } else if (has_s) {
+      vn = v + dt * F / ms;
+    } else if (has_w) {
+      wn = w + dt * Fw / mw;
+    }
+    a_s = has_s ? (vn - v) / dt : 0.0;
+    a_w = has_w ? (wn - w) / dt : 0.0;
+  }
+}
+
+/// The coupled grid solve of a two-phase scheme at every node: each record's momenta and forces
+/// become the new velocities and their accelerations (solve_two_phase_component); `solved` keeps
+/// the velocities (solid then water, 2 D values per node) for follow_held_phases.
+template <int D, PhaseNodes KIND>
+void solve_two_phase_nodes(const Simulation<D>& sim, double* records, const TwoPhaseRecord& k,
+                           double* solved, double dt) {
+  const double tol = sim.mass_tolerance;
+  for_each_node(sim.grid.num_nodes, sim.threads, [=](size_t i) {
+    double* r = records + i * size_t(k.stride);
+    double* sv = solved + i * 2 * D;
+    const double ms = r[k.solid_mass], mw = r[k.water_mass], Q = r[k.drag];
+    for (int d = 0; d < D; ++d) {
+      double& v = r[k.solid_velocity + d];
+      double& w = r[k.water_velocity + d];
+      double& a_s = r[k.solid_acceleration + d];
+      double& a_w = r[k.water_acceleration + d];
+      solve_two_phase_component<KIND>(ms, mw, Q, dt, tol, v, w, a_s, a_w, v, w, a_s, a_w);
+      sv[d] = v;
+      sv[D + d] = w;
+    }
+    if (KIND == PhaseNodes::kMixture && ms <= tol) r[k.drag] = r[k.porosity] = 0.0;
+  });
+}
+
 /// follow_held_phase at every node with both phases and drag, component by component, after the
 /// boundary conditions; `solved` holds the velocities of the coupled solve (solid then water,
 /// 2 D values per node).

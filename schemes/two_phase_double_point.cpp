@@ -808,7 +808,7 @@ class TwoPhaseDoublePoint : public Scheme<D> {
     sim.apply_grid_loads(NodalVector{node_.data(), S, kF});
     boundary_forces(sim);
     damp_phases(sim);
-    solve_coupled(sim, dt);
+    solve_two_phase_nodes<D, PhaseNodes::kSeparate>(sim, node_.data(), kRecord, solved_.data(), dt);
     constrain_two_phase_update<D>(sim, node_.data(), kRecord, solved_.data(), dt);
   }
 
@@ -857,38 +857,6 @@ class TwoPhaseDoublePoint : public Scheme<D> {
       sim.apply_damping(NodeForces{node_.data() + kMw, NodalVector{node_.data(), S, kW},
                                    NodalVector{node_.data(), S, kFw}, sim.grid.num_nodes, S},
                         nullptr, MomentumBalance::kLiquid);
-  }
-
-  /// Per node and component the two momentum equations with the drag implicit; a node with one
-  /// phase integrates it alone. The record then holds the new velocities and the accelerations;
-  /// solved_ keeps the velocities of the solve for follow_held_phases().
-  void solve_coupled(Simulation<D>& sim, double dt) {
-    const double tol = sim.mass_tolerance;
-    for_each_record(sim, [&](double* r, size_t i) {
-      double* solved = solved_.data() + i * 2 * D;
-      const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
-      const bool has_s = ms > tol, has_w = mw > tol;
-      // A light phase keeps its points' mean velocity p / m, without acceleration
-      // (light_node_velocity_scale).
-      const double light_s = light_node_velocity_scale(ms), light_w = light_node_velocity_scale(mw);
-      for (int d = 0; d < D; ++d) {
-        const double v = has_s ? r[kV + d] / ms : 0.0, w = has_w ? r[kW + d] / mw : 0.0;
-        const double Fs = r[kF + d], Fw = r[kFw + d];
-        double vn = r[kV + d] * light_s, wn = r[kW + d] * light_w;
-        if (has_s && has_w) {
-          const auto s = solve_drag_implicit(ms, mw, Q, dt, ms * v / dt + Fs, mw * w / dt + Fw);
-          vn = s.solid, wn = s.water;
-        } else if (has_s) {
-          vn = v + dt * Fs / ms;
-        } else if (has_w) {
-          wn = w + dt * Fw / mw;
-        }
-        r[kV + d] = solved[d] = vn;
-        r[kW + d] = solved[D + d] = wn;
-        r[kF + d] = has_s ? (vn - v) / dt : 0.0;
-        r[kFw + d] = has_w ? (wn - w) / dt : 0.0;
-      }
-    });
   }
 
   /// f(record, node) for every grid node, in parallel (static schedule).

@@ -474,7 +474,7 @@ class TwoPhaseSinglePoint : public Scheme<D> {
     f.count = 2;
     sim.apply_boundary_forces(f);
     damp_mixture(sim);
-    solve_coupled(sim, dt);
+    solve_two_phase_nodes<D, PhaseNodes::kMixture>(sim, node_.data(), kRecord, solved_.data(), dt);
     constrain_two_phase_update<D>(sim, node_.data(), kRecord, solved_.data(), dt);
   }
 
@@ -528,40 +528,6 @@ class TwoPhaseSinglePoint : public Scheme<D> {
                       nullptr, MomentumBalance::kLiquid);
     for_each_record(sim, [&](double* r, size_t i) {
       for (int d = 0; d < D; ++d) r[kF + d] += r[kFw + d] - water_force_[i * D + size_t(d)];
-    });
-  }
-
-  /// Per node and component, the water and mixture momentum equations with the drag implicit:
-  ///   (m_w/dt + Q) w' - Q v'           = m_w w/dt + F_w
-  ///   -Q w'          + (m_s/dt + Q) v' = m_s v/dt + F - F_w
-  /// The record then holds the new velocities and the accelerations (v' - v)/dt, (w' - w)/dt;
-  /// solved_ keeps the velocities of the solve for follow_held_phase().
-  void solve_coupled(Simulation<D>& sim, double dt) {
-    const double tol = sim.mass_tolerance;
-    for_each_record(sim, [&](double* r, size_t i) {
-      double* solved = solved_.data() + i * 2 * D;
-      const double ms = r[kMs], mw = r[kMw], Q = r[kQ];
-      if (ms <= tol) {  // a light node: its particles' mean velocities, no acceleration
-        const double ss = light_node_velocity_scale(ms), sw = light_node_velocity_scale(mw);
-        for (int d = 0; d < D; ++d) {
-          const double v = r[kV + d] * ss;
-          r[kV + d] = solved[d] = v;
-          r[kW + d] = solved[D + d] = sw > 0 ? r[kW + d] * sw : v;
-          r[kF + d] = r[kFw + d] = 0.0;
-        }
-        r[kQ] = r[kN] = 0.0;
-        return;
-      }
-      for (int d = 0; d < D; ++d) {
-        const double v = r[kV + d] / ms, w = mw > tol ? r[kW + d] / mw : v;
-        const double F = r[kF + d], Fw = r[kFw + d];
-        const auto s = solve_drag_implicit(ms, mw, Q, dt, ms * v / dt + F - Fw, mw * w / dt + Fw);
-        const double vn = s.solid, wn = mw <= tol ? s.solid : s.water;
-        r[kV + d] = solved[d] = vn;
-        r[kW + d] = solved[D + d] = wn;
-        r[kF + d] = (vn - v) / dt;
-        r[kFw + d] = (wn - w) / dt;
-      }
     });
   }
 
