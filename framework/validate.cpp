@@ -290,14 +290,10 @@ struct Validator {
       }
       case ParamType::Plugin: {
         // A map without `type:` takes the key's default plugin (e.g. `scheme: {update: usl}`).
-        if (n.IsMap() && !n["type"] && !spec.default_text.empty()) {
-          YAML::Node copy = YAML::Clone(n);
-          copy["type"] = spec.default_text;
-          return std::make_shared<Params>(
-              plugin(copy, spec.plugin_kind, spec.plugin_components, path, loc));
-        }
+        // The map itself is validated (not a copy with `type:` added: a copy has lost the
+        // marks, and its errors would read FILE:1:1).
         return std::make_shared<Params>(
-            plugin(n, spec.plugin_kind, spec.plugin_components, path, loc));
+            plugin(n, spec.plugin_kind, spec.plugin_components, path, loc, spec.default_text));
       }
       default:
         return {};
@@ -359,8 +355,11 @@ struct Validator {
     return out;
   }
 
+  /// A plugin entry: a name, a map with `type:` (or without it, given a default_type), or a
+  /// bare list for the kind's shorthand.
   Params plugin(const YAML::Node& n, const std::string& kind, int components,
-                const std::string& path, const Location& loc) {
+                const std::string& path, const Location& loc,
+                const std::string& default_type = "") {
     Params failed;
     failed.set_origin(path, loc);
     Registry& reg = Registry::instance();
@@ -378,14 +377,17 @@ struct Validator {
       return plugin(m, kind, components, path, loc);
     } else if (n.IsMap()) {
       YAML::Node t = n["type"];
-      if (!t || !t.IsScalar()) {
+      if (!t && !default_type.empty()) {
+        name = default_type;
+      } else if (!t || !t.IsScalar()) {
         diag.error(loc, type_path,
                    "missing required key 'type' (a " + kind +
                        "; valid types are: " + join(reg.names(kind), ", ") + ")");
         return failed;
+      } else {
+        name = t.Scalar();
+        type_loc = location_of(t, type_path, ctx, loc);
       }
-      name = t.Scalar();
-      type_loc = location_of(t, type_path, ctx, loc);
     } else {
       diag.error(loc, path,
                  "expected a " + kind + " name or a map with 'type', got " + node_text(n));

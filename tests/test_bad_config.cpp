@@ -650,3 +650,24 @@ TEST_CASE("an error quoting a key that spans lines is still one located line", "
         "run.yaml:32:5: error: bodies.0.  minus: [a]\\n  # comment: unknown key '  minus: "
         "[a]\\n  # comment\\r\\n'\n");
 }
+
+TEST_CASE("an error inside a plugin map without `type:` (the key's default plugin) is located",
+          "[bad_config]") {
+  // `scheme: {update: usx}` takes the scheme's default type; its keys are validated in the
+  // file's own node (a copy with `type:` added had lost the marks: every error read FILE:1:1).
+  Scratch s;
+  const auto r = s.run(
+      "grid: {extent: [1, 1], cell_size: 0.1}\n"
+      "time: {end: 0.01}\n"
+      "scheme: {update: usx, flip: 3}\n"
+      "bodies:\n"
+      "  - name: block\n"
+      "    generator: {type: box, min: [0.2, 0.2], max: [0.8, 0.8]}\n"
+      "    material: {type: linear_elastic, E: 1.0e6, nu: 0.3, density: 1000}\n");
+  std::printf("%s", r.err.c_str());
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find(s.error_at(3, 18, "scheme.update", "unknown value 'usx'")) != std::string::npos);
+  CHECK(r.err.find(s.error_at(3, 29, "scheme.flip", "3 is out of range [0, 1]")) !=
+        std::string::npos);
+  CHECK_FALSE(fs::exists(s.out()));
+}
