@@ -24,6 +24,7 @@
 // particles take PIC from it, so their velocities stay a rigid motion. Two rigid bodies pass
 // through each other.
 #include <omp.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
@@ -154,14 +155,24 @@ class ContactFields {
     supported_.clear();
     if (!rigid_.any()) return supported_;
     const double tol = sim.mass_tolerance;
+    int first_overlap[2] = {-1, -1};
     for (size_t n = 0; n < nodes_; ++n) {
-      bool rigid = false, other = false;
+      int rigid = 0, last_rigid = -1;
+      bool other = false;
       for (int f = 0; f < fields_; ++f) {
         const bool mass = rec_[(size_t(f) * nodes_ + n) * S + kMass] > tol;
-        (rigid_.field_is_rigid(f) ? rigid : other) |= mass;
+        if (!mass) continue;
+        if (!rigid_.field_is_rigid(f)) {
+          other = true;
+        } else {
+          if (++rigid == 2 && first_overlap[0] < 0)
+            first_overlap[0] = last_rigid, first_overlap[1] = f;
+          last_rigid = f;
+        }
       }
-      if (rigid && other) supported_.push_back(n);
+      if (rigid > 0 && other) supported_.push_back(n);
     }
+    if (first_overlap[0] >= 0) warn_rigid_bodies_meet(sim, first_overlap[0], first_overlap[1]);
     return supported_;
   }
 
@@ -268,7 +279,23 @@ class ContactFields {
   std::vector<uint8_t> touching_;  // per node: the last update's exchange changed a velocity
   std::vector<double> vel_;        // fields * nodes * D: re-mapped momenta, then velocities
   std::vector<size_t> supported_;  // supported_nodes()
-  RigidFields<D> rigid_;           // the fields of rigid bodies
+  bool warned_rigid_meet_ = false;
+
+  /// Two rigid bodies reach one node: contact between rigid bodies is not modelled, they pass
+  /// through each other (docs/contact.md, Limits). Said once per run, not silently.
+  void warn_rigid_bodies_meet(const Simulation<D>& sim, int field_a, int field_b) {
+    if (warned_rigid_meet_) return;
+    warned_rigid_meet_ = true;
+    std::string names;
+    for (size_t b = 0; b < field_of_body_.size(); ++b)
+      if (field_of_body_[b] == field_a || field_of_body_[b] == field_b)
+        names += (names.empty() ? "'" : " and '") + sim.bodies[b].name + "'";
+    spdlog::warn(
+        "t = {:.6g} s: the rigid bodies {} reach the same grid nodes; contact between rigid "
+        "bodies is not modelled, they pass through each other (docs/contact.md, Limits)",
+        sim.time, names);
+  }
+  RigidFields<D> rigid_;  // the fields of rigid bodies
   static_assert(RigidFields<D>::S == S && RigidFields<D>::kForce == kForce);
 
   static constexpr int kMaxFields = 8;
