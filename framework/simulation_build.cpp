@@ -447,7 +447,6 @@ template <int D>
 void Simulation<D>::set_initial_velocity_and_stress(const GeneratedPoints& pts) {
   Registry& reg = Registry::instance();
   const auto& bl = config.list("bodies");
-  const auto& [xs, owner, vols, ids, first_kept] = pts;
   std::vector<double> value(size_t(Particles<D>::NS));
   for (size_t b = 0; b < bl.size(); ++b) {
     const Params& bp = bl[b];
@@ -458,7 +457,7 @@ void Simulation<D>::set_initial_velocity_and_stress(const GeneratedPoints& pts) 
       auto f = reg.create<Field, D>(bp.section(key));
       const int nc = P.info(field).components;
       for (size_t k = 0; k < bodies[b].local_count; ++k) {
-        f->value(xs[first_kept[b] + k], value.data());
+        f->value(pts.x[pts.first_kept[b] + k], value.data());
         for (int c = 0; c < nc; ++c) P.col(field, c)[bodies[b].first_index + k] = value[size_t(c)];
       }
     }
